@@ -1,0 +1,41 @@
+"""Exceptions the toolkit raises at its boundaries."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with an input file.
+
+    ``field`` is a dotted path such as ``finger.I.type`` or ``load.F[2]``.
+    """
+
+    file: str
+    field: str
+    message: str
+
+    def __str__(self) -> str:
+        where = f"{self.file}: {self.field}" if self.field else self.file
+        return f"{where}: {self.message}"
+
+
+class ProblemFileError(ValueError):
+    """An input file (scene, problem or model) has one or more problems.
+
+    All problems found in one validation pass are carried together so that a
+    user can fix them in one go.
+    """
+
+    def __init__(self, problems: list[Problem]):
+        self.problems = list(problems)
+        super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class MethodUnsupportedError(ValueError):
+    """A solver method was asked for a case it cannot solve correctly.
+
+    Raised instead of returning a wrong number, e.g. the Frisch-Fay closed
+    form for a finger whose EI varies along its length.
+    """
