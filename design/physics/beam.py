@@ -1,0 +1,138 @@
+"""The large-deflection cantilever finger under a point load (thesis ch. II).
+
+Finger frame: clamped at the origin, straight along +x when unloaded, arc
+length s (m), slope ψ(s) (rad). A force of magnitude F (N) acts at arc length
+L (``at``) with direction angle α:
+
+    F_vec = F (-cos α, sin α)          α = π/2: transverse push in +y
+
+First-order form (MODEL.md §2), with M the bending moment (N m):
+
+    x' = cos ψ,  y' = sin ψ,  ψ' = M / EI(s),  M' = F_x sin ψ - F_y cos ψ
+    x(0) = y(0) = ψ(0) = 0,  M(L) = 0
+
+Beyond the load point the finger is straight.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from design.physics.stiffness import Stiffness
+
+
+@dataclass(frozen=True)
+class Finger:
+    """A compliant finger: length (m) and flexural rigidity profile."""
+
+    length: float
+    stiffness: Stiffness
+    name: str = ""
+
+    def describe(self) -> dict:
+        return {"name": self.name, "length": self.length, "stiffness": self.stiffness.describe()}
+
+
+@dataclass(frozen=True)
+class PointLoad:
+    """Point force on the finger: magnitude ``force`` (N, ≥ 0), direction
+    ``alpha`` (rad, force = F(-cos α, sin α) in the finger frame), applied at
+    arc length ``at`` (m)."""
+
+    force: float
+    alpha: float
+    at: float
+
+    @property
+    def components(self) -> tuple[float, float]:
+        """(F_x, F_y) in the finger frame, N."""
+        return -self.force * np.cos(self.alpha), self.force * np.sin(self.alpha)
+
+
+@dataclass(frozen=True)
+class BeamSolution:
+    """Equilibrium shape of the loaded part of a finger, 0 ≤ s ≤ L.
+
+    Arrays ``s, x, y, psi, moment`` share one length; the last entry is the
+    load point. ``error_estimate`` (m) bounds the load-point position error
+    of this solution against the exact solution of the model the method
+    solves (for small-deflection: against the elastica).
+    """
+
+    load: PointLoad
+    method: str
+    s: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    psi: np.ndarray
+    moment: np.ndarray
+    error_estimate: float
+    converged: bool
+    branch: str
+    iterations: int = 0
+    message: str = ""
+    #: True/False where the method could tell whether another equilibrium
+    #: exists for this load; None where it could not.
+    multiple_equilibria: bool | None = None
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def tip(self) -> tuple[float, float, float]:
+        """(x, y, ψ) of the load point in the finger frame (m, m, rad)."""
+        return float(self.x[-1]), float(self.y[-1]), float(self.psi[-1])
+
+    def base_moment_error(self) -> float:
+        """|M(0) - (x_c F_y - y_c F_x)| in N m: equilibrium of the whole beam."""
+        fx, fy = self.load.components
+        return abs(float(self.moment[0]) - (self.x[-1] * fy - self.y[-1] * fx))
+
+
+def rhs(s: np.ndarray, state: np.ndarray, load: PointLoad, stiffness: Stiffness) -> np.ndarray:
+    """d/ds of state (x, y, ψ, M) for the first-order elastica (any shape of trailing axes)."""
+    _, _, psi, m = state
+    fx, fy = load.components
+    return np.array([np.cos(psi), np.sin(psi), m / stiffness.ei(s),
+                     fx * np.sin(psi) - fy * np.cos(psi)])
+
+
+def straight_solution(load: PointLoad, method: str, n: int = 2, branch: str = "straight",
+                      message: str = "") -> BeamSolution:
+    """The undeflected finger (F = 0, pure tension, or axial load below buckling)."""
+    s = np.linspace(0.0, load.at, n)
+    z = np.zeros_like(s)
+    fx, fy = load.components
+    moment = (load.at - s) * fy  # zero unless F has a transverse part
+    return BeamSolution(load, method, s, s.copy(), z, z.copy(), moment, 0.0, True, branch,
+                        message=message, multiple_equilibria=False)
+
+
+def normalise_angle(alpha: float) -> float:
+    """α mapped into (-π, π]."""
+    a = (alpha + np.pi) % (2 * np.pi) - np.pi
+    return np.pi if a == -np.pi else a
+
+
+def classify_branch(alpha: float, psi: np.ndarray, tol: float = 1e-9) -> str:
+    """Name the equilibrium branch from the slope along the finger.
+
+    ``straight``: ψ ≡ 0. ``primary``: the finger bends to the side the
+    transverse force pushes it (ψ·sin α ≥ 0 throughout), the branch connected
+    to F = 0. ``buckled+``/``buckled-``: bent under a purely axial load.
+    ``secondary``: bent against the transverse force, reachable only past a
+    fold (exists only for near-axial loads above the buckling range).
+    """
+    span = float(np.max(np.abs(psi))) if psi.size else 0.0
+    if span <= tol:
+        return "straight"
+    a = normalise_angle(alpha)
+    if abs(np.sin(a)) < 1e-15:
+        return "buckled+" if psi[-1] > 0 else "buckled-"
+    direction = np.sign(np.sin(a))
+    return "primary" if np.all(direction * psi >= -tol * max(span, 1.0)) else "secondary"
+
+
+def small_deflection_tip(load: PointLoad, ei: float) -> float:
+    """Transverse load-point deflection of a uniform beam, linear theory (eq. 2.5), m."""
+    return load.force * np.sin(load.alpha) * load.at ** 3 / (3.0 * ei)
