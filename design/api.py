@@ -1,0 +1,51 @@
+"""The Python API behind the ``design`` command.
+
+>>> import design
+>>> result = design.simulate({"kind": "beam", "finger": {"length": 0.2, "EI": 0.08},
+...                           "load": {"F": 15, "alpha": "90 deg", "at": "4 in"},
+...                           "solver": {"method": "frisch-fay"}})
+>>> round(result["cases"][0]["tip"]["y"], 5)
+0.04918
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from design.io.beam_scene import BeamScene
+from design.io.results import write_outputs
+from design.io.scene import check_file, load_scene
+from design.run import Progress, RunOutput
+from design.run import beam as beam_run
+
+RUNNERS = {BeamScene: beam_run.run}
+
+
+def run_scene(source: str | Path | Mapping, progress: Progress | None = None) -> RunOutput:
+    """Validate and run a scene; the full output (result and CSV tables)."""
+    scene = load_scene(source)
+    return RUNNERS[type(scene)](scene, progress)
+
+
+def simulate(source: str | Path | Mapping, out: str | Path | None = None,
+             progress: Progress | None = None) -> dict:
+    """Solve a scene given as a file path or as the file's content (a mapping).
+
+    Returns the dict that ``design simulate`` writes to ``result.json``; with
+    ``out``, also writes it and the CSV tables there.
+
+    Raises
+    ------
+    design.errors.ProblemFileError
+        If the scene has problems (nothing is written then).
+    """
+    output = run_scene(source, progress)
+    if out is not None:
+        write_outputs(Path(out), output.result, output.tables)
+    return output.result
+
+
+def check(source: str | Path | Mapping) -> object:
+    """Validate any input file (scene or model); returns the object it describes."""
+    return check_file(source)

@@ -1,0 +1,86 @@
+"""The ``design`` command.
+
+Exit status: 0 success; 1 the run finished but did not succeed (a case did
+not converge, a verification failed); 2 bad input (nothing was written).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from design.errors import ProblemFileError
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+
+
+def _progress(message: str) -> None:
+    print(f"[design] {message}", file=sys.stderr, flush=True)
+
+
+def _report_problems(exc: ProblemFileError) -> int:
+    for problem in exc.problems:
+        print(f"error: {problem}", file=sys.stderr)
+    n = len(exc.problems)
+    print(f"{n} problem{'s' if n != 1 else ''} found; nothing was written.", file=sys.stderr)
+    return EXIT_BAD_INPUT
+
+
+def cmd_simulate(args: argparse.Namespace) -> int:
+    from design.api import run_scene
+    from design.io.results import write_outputs
+
+    try:
+        output = run_scene(args.scene, None if args.quiet else _progress)
+    except ProblemFileError as exc:
+        return _report_problems(exc)
+    name = output.result.get("name") or Path(args.scene).stem
+    out = Path(args.out) if args.out else Path("reports") / name
+    written = write_outputs(out, output.result, output.tables)
+    for path in written:
+        print(path)
+    if not output.ok:
+        print("warning: not every case converged; see 'converged' and 'message' in result.json",
+              file=sys.stderr)
+        return EXIT_FAILED
+    return EXIT_OK
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    from design.api import check
+
+    status = EXIT_OK
+    for path in args.files:
+        try:
+            check(path)
+            print(f"{path}: OK")
+        except ProblemFileError as exc:
+            for problem in exc.problems:
+                print(f"error: {problem}", file=sys.stderr)
+            status = EXIT_BAD_INPUT
+    return status
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="design", description="Optimal design and timing of compliant graspers.")
+    sub = parser.add_subparsers(dest="command", required=True)
+    p = sub.add_parser("simulate", help="solve a scene file and write its results")
+    p.add_argument("scene", help="scene file (YAML)")
+    p.add_argument("--out", help="output folder (default: reports/<scene name>/)")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("check", help="validate input files and report every problem")
+    p.add_argument("files", nargs="+", help="scene, problem or model files (YAML)")
+    p.set_defaults(func=cmd_check)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

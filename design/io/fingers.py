@@ -1,0 +1,122 @@
+"""Reading a finger (inline or from ``models/fingers/*.yaml``) into a :class:`Finger`.
+
+A finger is ``{length, EI}`` for a uniform finger, or ``{length, E, I}`` with
+``I`` one of::
+
+    {type: uniform, value: 1.67e-8}                         # m^4
+    {type: exponential, A: .., B: .., C: .., a: .., b: ..}  # I = A e^(a s) + B e^(b s) + C
+    {type: table, s: [...], I: [...]}                       # linear between points
+
+A finger file may also carry ``kind: finger``, ``name``, ``description`` and
+``source``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from design.io.files import TOOLKIT_ROOT, load_yaml, resolve
+from design.io.reader import Reader, join
+from design.physics.beam import Finger
+from design.physics.stiffness import ExponentialI, Stiffness, TableI, UniformEI
+
+I_TYPES = ("uniform", "exponential", "table")
+_FINGER_KEYS = ("length", "EI", "E", "I", "name", "description", "source", "kind")
+
+
+def read_finger(reader: Reader, value: object, field: str, base_dir: Path) -> Finger | None:
+    """A finger given inline (mapping) or as a path to a finger file."""
+    if isinstance(value, str):
+        path = resolve(value, base_dir)
+        if path is None:
+            reader.add(field, f"finger file '{value}' not found (looked in {base_dir}, "
+                              f"its parent folders, {Path.cwd()} and {TOOLKIT_ROOT})")
+            return None
+        sub = Reader(str(path))
+        data = load_yaml(path, sub)
+        finger = None if data is None else _finger(sub, data, "", default_name=path.stem)
+        reader.problems.extend(sub.problems)
+        return finger
+    return _finger(reader, value, field, default_name="")
+
+
+def _finger(reader: Reader, value: object, field: str, default_name: str) -> Finger | None:
+    data = reader.mapping(value, field, required=("length",), optional=_FINGER_KEYS[1:])
+    if data is None:
+        return None
+    if "kind" in data and data["kind"] != "finger":
+        reader.add(join(field, "kind"), f"'{data['kind']}' in a finger; expected 'finger'")
+    length = reader.quantity(data, "length", field, "length", lo=0.0, lo_open=True)
+    name = reader.text(data, "name", field, default=default_name)
+    reader.text(data, "description", field, default="")
+    reader.text(data, "source", field, default="")
+    stiffness = read_stiffness(reader, data, field)
+    if stiffness is not None and length is not None:
+        _check_positive(reader, stiffness, length, field)
+    if stiffness is None or length is None or name is None:
+        return None
+    return Finger(length, stiffness, name)
+
+
+def read_stiffness(reader: Reader, data: dict, field: str) -> Stiffness | None:
+    """EI, or E with an I profile, from a finger mapping."""
+    has_ei, has_e, has_i = "EI" in data, "E" in data, "I" in data
+    if has_ei and (has_e or has_i):
+        reader.add(join(field, "EI"), "give either EI, or E with I, not both")
+        return None
+    if has_ei:
+        ei = reader.quantity(data, "EI", field, "flexural_rigidity", lo=0.0, lo_open=True)
+        return None if ei is None else UniformEI(ei)
+    if not (has_e and has_i):
+        missing = "E" if has_i else "I" if has_e else "EI (or E with I)"
+        reader.add(join(field, missing.split()[0]), f"required but missing: {missing}")
+        return None
+    E = reader.quantity(data, "E", field, "modulus", lo=0.0, lo_open=True)
+    f_i = join(field, "I")
+    spec = reader.mapping(data["I"], f_i, required=("type",),
+                          optional=("value", "A", "B", "C", "a", "b", "s", "I"))
+    if spec is None:
+        return None
+    kind = reader.choice(spec, "type", f_i, I_TYPES)
+    if kind is None or E is None:
+        return None
+    allowed = {"uniform": ("value",), "exponential": ("A", "B", "C", "a", "b"),
+               "table": ("s", "I")}[kind]
+    for key in spec:
+        if key != "type" and key not in allowed:
+            reader.add(join(f_i, key), f"not a parameter of I type '{kind}' "
+                                       f"(allowed: {', '.join(allowed)})")
+    if kind == "uniform":
+        value = reader.quantity(spec, "value", f_i, "area_moment", lo=0.0, lo_open=True)
+        return None if value is None else UniformEI(E * value)
+    if kind == "exponential":
+        coef = {k: reader.quantity(spec, k, f_i, "area_moment") for k in ("A", "B", "C")}
+        rate = {k: reader.quantity(spec, k, f_i, "inverse_length") for k in ("a", "b")}
+        if any(v is None for v in (*coef.values(), *rate.values())):
+            return None
+        return ExponentialI(E, coef["A"], coef["B"], coef["C"], rate["a"], rate["b"])
+    s = reader.quantities(spec, "s", f_i, "length", lo=0.0)
+    values = reader.quantities(spec, "I", f_i, "area_moment", lo=0.0, lo_open=True)
+    if s is None or values is None:
+        return None
+    if len(s) != len(values) or len(s) < 2:
+        reader.add(f_i, f"table needs at least 2 points and as many s as I values "
+                        f"(got {len(s)} s and {len(values)} I)")
+        return None
+    if np.any(np.diff(s) <= 0):
+        reader.add(join(f_i, "s"), "arc lengths must be strictly increasing")
+        return None
+    return TableI(E, tuple(s), tuple(values))
+
+
+def _check_positive(reader: Reader, stiffness: Stiffness, length: float, field: str) -> None:
+    """EI must stay positive over the whole finger (a fitted profile may not)."""
+    s = np.linspace(0.0, length, 1001)
+    ei = stiffness.ei(s)
+    if np.any(~np.isfinite(ei)) or np.any(ei <= 0):
+        bad = s[np.argmax(~np.isfinite(ei) | (ei <= 0))]
+        reader.add(join(field, "I"), f"EI(s) is not positive at s = {bad:g} m, inside the "
+                                     f"finger (length {length:g} m); accepted: EI > 0 N m^2 "
+                                     f"on [0, length]")

@@ -1,0 +1,69 @@
+"""Writing results: JSON and CSV, atomically, SI units throughout."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+
+def jsonable(value: object) -> object:
+    """numpy arrays and scalars to lists and floats; non-finite floats to None."""
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, np.ndarray):
+        return jsonable(value.tolist())
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer,)):
+        return int(value)
+    if isinstance(value, (float, np.floating)):
+        v = float(value)
+        return v if math.isfinite(v) else None
+    return value
+
+
+def write_atomic(path: Path, text: str) -> None:
+    """Write ``text`` to ``path`` through a temporary file and a rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def csv_text(rows: list[dict]) -> str:
+    """CSV of a list of flat dicts (columns from the first row)."""
+    buf = io.StringIO()
+    if rows:
+        writer = csv.DictWriter(buf, fieldnames=list(rows[0]))
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({k: ("" if v is None else v) for k, v in jsonable(row).items()})
+    return buf.getvalue()
+
+
+def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]]) -> list[Path]:
+    """Write ``result.json`` and each CSV table; returns the paths written.
+
+    Everything is rendered in memory first, so an error leaves no partial file.
+    """
+    files = {"result.json": json.dumps(jsonable(result), indent=1, allow_nan=False) + "\n"}
+    files.update({name: csv_text(rows) for name, rows in tables.items()})
+    written = []
+    for name, text in files.items():
+        write_atomic(out_dir / name, text)
+        written.append(out_dir / name)
+    return written

@@ -1,0 +1,72 @@
+"""Reading any input file: dispatch on its ``kind``, collect every problem.
+
+Scene kinds are simulated by ``design simulate``; model kinds (``finger``)
+can be checked on their own by ``design check``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+from design.errors import ProblemFileError
+from design.io.beam_scene import read_beam
+from design.io.fingers import read_finger
+from design.io.files import load_yaml
+from design.io.reader import Reader
+
+#: kind -> (required top-level keys, optional top-level keys, reader)
+KINDS = {
+    "beam": (("finger", "load"), ("solver",), read_beam),
+}
+MODEL_KINDS = ("finger",)
+_COMMON = ("kind", "name", "description")
+
+
+def load_scene(source: str | Path | Mapping) -> object:
+    """Read and validate a scene file (path) or its content (mapping).
+
+    Returns the kind's settings object (e.g. :class:`~design.io.beam_scene.BeamScene`).
+
+    Raises
+    ------
+    ProblemFileError
+        With every problem found, each naming the file and the field.
+    """
+    reader, data, base_dir, name = _open(source)
+    scene = None
+    if data is not None:
+        kind = reader.choice(data, "kind", "", list(KINDS))
+        if kind is not None:
+            required, optional, read = KINDS[kind]
+            reader.mapping(data, "", required=required, optional=(*optional, *_COMMON))
+            reader.text(data, "name", "", default=name)
+            reader.text(data, "description", "", default="")
+            scene = read(reader, data, base_dir, data.get("name", name))
+    reader.raise_if_any()
+    return scene
+
+
+def check_file(source: str | Path | Mapping) -> object:
+    """Validate any input file, scene or model; returns what it describes."""
+    reader, data, base_dir, name = _open(source)
+    if isinstance(data, Mapping) and data.get("kind") in MODEL_KINDS:
+        finger = read_finger(reader, dict(data), "", base_dir)
+        reader.raise_if_any()
+        return finger
+    reader.raise_if_any()
+    return load_scene(source)
+
+
+def _open(source: str | Path | Mapping) -> tuple[Reader, dict | None, Path, str]:
+    if isinstance(source, Mapping):
+        return Reader("<scene>"), dict(source), Path.cwd(), "scene"
+    path = Path(source)
+    reader = Reader(str(source))
+    data = load_yaml(path, reader)
+    if data is None and reader.ok:
+        reader.add("", "the file is empty")
+    elif data is not None and not isinstance(data, Mapping):
+        reader.mapping(data, "")
+        data = None
+    return reader, data, path.resolve().parent, path.stem

@@ -1,0 +1,19 @@
+"""Running a validated scene: each kind's runner returns a :class:`RunOutput`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Callable
+
+#: progress(message) callback for long runs
+Progress = Callable[[str], None]
+
+
+@dataclass
+class RunOutput:
+    """What a run produced: the result dict (written as result.json) and CSV tables."""
+
+    result: dict
+    tables: dict[str, list[dict]] = field(default_factory=dict)
+    #: true when every case converged / the run succeeded
+    ok: bool = True
