@@ -5,7 +5,7 @@ A finger is ``{length, EI}`` for a uniform finger, or ``{length, E, I}`` with
 
     {type: uniform, value: 1.67e-8}                         # m^4
     {type: exponential, A: .., B: .., C: .., a: .., b: ..}  # I = A e^(a s) + B e^(b s) + C
-    {type: table, s: [...], I: [...]}                       # linear between points
+    {type: table, s: [...], I: [...]}                       # cubic spline, s from 0 to length
 
 A finger file may also carry ``kind: finger``, ``name``, ``description`` and
 ``source``.
@@ -53,7 +53,11 @@ def _finger(reader: Reader, value: object, field: str, default_name: str) -> Fin
     reader.text(data, "description", field, default="")
     reader.text(data, "source", field, default="")
     stiffness = read_stiffness(reader, data, field)
-    if stiffness is not None and length is not None:
+    if isinstance(stiffness, TableI) and length is not None and stiffness.s_knots[-1] < length:
+        reader.add(join(field, "I.s"), f"the table ends at s = {stiffness.s_knots[-1]:g} m, "
+                                       f"before the finger's end ({length:g} m); it must cover "
+                                       f"[0, length]")
+    elif stiffness is not None and length is not None:
         _check_positive(reader, stiffness, length, field)
     if stiffness is None or length is None or name is None:
         return None
@@ -107,6 +111,9 @@ def read_stiffness(reader: Reader, data: dict, field: str) -> Stiffness | None:
         return None
     if np.any(np.diff(s) <= 0):
         reader.add(join(f_i, "s"), "arc lengths must be strictly increasing")
+        return None
+    if s[0] != 0.0:
+        reader.add(join(f_i, "s"), f"the table must start at the base, s = 0 (starts at {s[0]:g} m)")
         return None
     return TableI(E, tuple(s), tuple(values))
 

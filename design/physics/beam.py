@@ -117,20 +117,21 @@ def normalise_angle(alpha: float) -> float:
 def classify_branch(alpha: float, psi: np.ndarray, tol: float = 1e-9) -> str:
     """Name the equilibrium branch from the slope along the finger.
 
-    ``straight``: ψ ≡ 0. ``primary``: the finger bends to the side the
-    transverse force pushes it (ψ·sin α ≥ 0 throughout), the branch connected
-    to F = 0. ``buckled+``/``buckled-``: bent under a purely axial load.
-    ``secondary``: bent against the transverse force, reachable only past a
-    fold (exists only for near-axial loads above the buckling range).
+    For a load with a transverse part (sin α ≠ 0): ``primary`` when the
+    finger bends to the side the transverse force pushes it (ψ sin α ≥ 0
+    throughout), the branch connected to F = 0; ``secondary`` otherwise, bent
+    against the force, reachable only past a fold (near-axial loads above
+    the buckling range). For a purely axial load: ``straight`` while
+    |ψ| ≤ ``tol`` (rad), else ``buckled+``/``buckled-`` by the tip's side.
     """
     span = float(np.max(np.abs(psi))) if psi.size else 0.0
-    if span <= tol:
-        return "straight"
     a = normalise_angle(alpha)
-    if abs(np.sin(a)) < 1e-15:
+    if a in (0.0, np.pi):
+        if span <= tol:
+            return "straight"
         return "buckled+" if psi[-1] > 0 else "buckled-"
     direction = np.sign(np.sin(a))
-    return "primary" if np.all(direction * psi >= -tol * max(span, 1.0)) else "secondary"
+    return "primary" if np.all(direction * psi >= -tol * span) else "secondary"
 
 
 def small_deflection_tip(load: PointLoad, ei: float) -> float:

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 
 class Stiffness(ABC):
@@ -25,6 +26,13 @@ class Stiffness(ABC):
 
     #: True when EI does not vary along the finger (closed forms apply).
     uniform: bool = False
+    #: EI is C^k in s (None: infinitely smooth). Caps the convergence order
+    #: that error estimates may assume at k + 1.
+    smoothness: int | None = None
+
+    def order_cap(self, order: int) -> int:
+        """The order a method of nominal ``order`` can show on this profile."""
+        return order if self.smoothness is None else min(order, self.smoothness + 1)
 
     @abstractmethod
     def ei(self, s: np.ndarray | float) -> np.ndarray:
@@ -137,35 +145,45 @@ class ExponentialI(Stiffness):
 
 @dataclass(frozen=True)
 class TableI(Stiffness):
-    """EI(s) = E I(s) with I linear between tabulated points, constant beyond.
+    """EI(s) = E I(s), I a cubic spline through tabulated points.
 
-    E in Pa; ``s`` (m, strictly increasing) and ``I`` (m^4) are the table.
-    The derivative is piecewise constant, so methods lose their formal order
-    at the knots unless the mesh contains them.
+    E in Pa; ``s_knots`` (m, strictly increasing, from 0 to at least the
+    finger length) and ``I_knots`` (m^4). Not-a-knot cubic spline (linear for
+    two points, quadratic for three): C2, so RK4 and collocation keep order 4
+    across the knots, where linear interpolation would drop them to 2.
     """
 
     E: float
     s_knots: tuple[float, ...]
     I_knots: tuple[float, ...]
+    smoothness = 2
+
+    def __post_init__(self):
+        object.__setattr__(self, "_spline", CubicSpline(self.s_knots, self.I_knots,
+                                                        bc_type="not-a-knot"))
+
+    def _clamp(self, s):
+        return np.clip(np.asarray(s, dtype=float), self.s_knots[0], self.s_knots[-1])
 
     def ei(self, s):
-        return self.E * np.interp(s, self.s_knots, self.I_knots)
+        return self.E * self._spline(self._clamp(s))
 
     def dei(self, s):
-        s = np.asarray(s, dtype=float)
-        k = np.asarray(self.s_knots)
-        slopes = np.diff(self.I_knots) / np.diff(k)
-        idx = np.clip(np.searchsorted(k, s, side="right") - 1, 0, len(slopes) - 1)
-        inside = (s >= k[0]) & (s <= k[-1])
-        return self.E * np.where(inside, slopes[idx], 0.0)
+        return self.E * self._spline(self._clamp(s), 1)
 
     @property
     def params(self):
         return np.array([self.E])
 
     def ei_casadi(self, s, p):
-        inside = ca.fmin(ca.fmax(s, self.s_knots[0]), self.s_knots[-1])
-        return p[0] * ca.pw_lin(inside, list(self.s_knots), list(self.I_knots))
+        sp = self._spline
+        s = ca.fmin(ca.fmax(s, self.s_knots[0]), self.s_knots[-1])
+        value = None
+        for i in reversed(range(sp.c.shape[1])):
+            ds = s - sp.x[i]
+            piece = ((sp.c[0, i] * ds + sp.c[1, i]) * ds + sp.c[2, i]) * ds + sp.c[3, i]
+            value = piece if value is None else ca.if_else(s < sp.x[i + 1], piece, value)
+        return p[0] * value
 
     def symbolic_key(self):
         return (type(self).__name__, self.s_knots, self.I_knots)

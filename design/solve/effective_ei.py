@@ -25,7 +25,7 @@ from scipy import optimize
 from design.physics.beam import Finger, PointLoad, normalise_angle
 from design.physics.stiffness import UniformEI
 from design.solve.beam import solve_beam
-from design.solve.beam.frisch_fay import FrischFay, _kl_of_d
+from design.solve.beam.frisch_fay import FrischFay, kl_of
 
 THESIS_CALIBRATION = 1.48
 
@@ -62,7 +62,7 @@ def slope_matched_ei(load: PointLoad, psi0: float) -> float:
     d = np.pi - a - p0
     if not 0.0 < d < np.pi - a:
         raise ValueError(f"slope {psi0} rad is not on the primary branch for alpha = {alpha} rad")
-    kl = float(_kl_of_d(np.array([d]), np.array([a]))[0][0])
+    kl = float(kl_of(np.array([a]), np.array([d]), np.array([p0]))[0][0])
     return load.force * load.at ** 2 / kl ** 2
 
 

@@ -17,8 +17,13 @@ from typing import ClassVar, Sequence
 
 import numpy as np
 
-from design.physics.beam import BeamSolution, Finger, PointLoad, straight_solution
+from design.physics.beam import BeamSolution, Finger, PointLoad, normalise_angle, straight_solution
 from design.physics.stiffness import UniformEI
+
+
+#: branches a solve may return: connected to F = 0 (for α = 0, past the
+#: Euler load, the buckled shape is taken on the +y side by convention)
+CONTINUED_BRANCHES = ("primary", "straight", "buckled+")
 
 
 class BeamMethod(ABC):
@@ -34,8 +39,9 @@ class BeamMethod(ABC):
     """
 
     name: ClassVar[str]
-    #: Formal convergence order of the load-point position in 1/nodes
-    #: (None: exact up to root-finding, or not a discretisation).
+    #: Convergence order in 1/nodes that the error estimate assumes: the
+    #: nominal order, or less where that is not reached in practice (None:
+    #: exact up to root-finding, or not a discretisation).
     order: ClassVar[int | None]
     default_nodes: ClassVar[int]
     default_tolerance: ClassVar[float] = 1e-12
@@ -73,13 +79,23 @@ class IterativeMethod(BeamMethod):
         return out  # type: ignore[return-value]
 
     def solve_one(self, load: PointLoad, guess: BeamSolution | None = None) -> BeamSolution:
-        """One load: Newton from ``guess`` (or the seed), load stepping on failure."""
+        """One load on the branch continued from F = 0.
+
+        Newton from ``guess`` (the previous load of a sweep), else from the
+        seed; if that fails or lands on another branch (a warm start near a
+        buckling load can), from the seed; then by load stepping from zero.
+        """
         if load.force == 0.0:
             return straight_solution(load, self.name, self.nodes + 1, message="no load")
-        sol = self._solve(load, guess if guess is not None else seed(self.finger, load))
-        if sol.converged:
-            return sol
-        total = sol.iterations
+        if normalise_angle(load.alpha) == 0.0:
+            return self._finish(self._axial(load))
+        tries = [guess, None] if guess is not None else [None]
+        total = 0
+        for start in tries:
+            sol = self._solve(load, start if start is not None else seed(self.finger, load))
+            total += sol.iterations
+            if sol.converged and sol.branch in CONTINUED_BRANCHES:
+                return self._finish(replace(sol, iterations=total))
         prev = None
         for f in np.linspace(0.0, load.force, 17)[1:]:
             step_load = replace(load, force=float(f))
@@ -88,20 +104,75 @@ class IterativeMethod(BeamMethod):
             if not prev.converged:
                 break
         assert prev is not None
-        msg = "converged by load stepping after Newton from the seed failed" if prev.converged \
-            else f"did not converge, even with load stepping: {prev.message}"
-        return replace(prev, load=load, iterations=total, message=msg)
+        ok = prev.converged and prev.branch in CONTINUED_BRANCHES
+        msg = ("converged by load stepping after Newton from the seed failed" if ok else
+               f"no equilibrium on the continued branch found, even by load stepping "
+               f"(last: branch {prev.branch}; {prev.message or 'converged'})")
+        return self._finish(replace(prev, load=load, iterations=total, converged=ok, message=msg))
+
+    def _axial(self, load: PointLoad) -> BeamSolution:
+        """Pure compression: straight below the buckling load, buckled (+y) above.
+
+        A non-uniform finger buckles no earlier than a uniform one with its
+        smallest EI, so below that Euler load the answer is straight; above,
+        Newton starts from that beam's buckled shape and the straight state
+        (unstable once a buckled equilibrium exists) is returned only if no
+        buckled one is found.
+        """
+        ei_min = float(np.min(self.finger.stiffness.ei(np.linspace(0.0, load.at, 201))))
+        if load.force * load.at ** 2 / ei_min <= (np.pi / 2) ** 2:
+            return straight_solution(load, self.name, self.nodes + 1,
+                                     message="axial compression below the buckling load")
+        sol = self._solve(load, seed(self.finger, load, ei=ei_min))
+        if sol.converged and sol.branch == "buckled+":
+            return sol
+        return straight_solution(load, self.name, self.nodes + 1,
+                                 message="axial compression: no buckled equilibrium found")
+
+    def _finish(self, sol: BeamSolution) -> BeamSolution:
+        """Say whether another equilibrium exists, where that is known (uniform EI)."""
+        if not self.finger.stiffness.uniform or sol.multiple_equilibria is not None:
+            return sol
+        from design.solve.beam.frisch_fay import FrischFay
+
+        ff = FrischFay(self.finger, nodes=2).solve([sol.load])[0]
+        return replace(sol, multiple_equilibria=ff.multiple_equilibria)
+
+    def _solve(self, load: PointLoad, guess: BeamSolution) -> BeamSolution:
+        """Solve at the method's resolution and at half of it; the pair gives
+        the error estimate (Richardson, order capped by the stiffness's
+        smoothness), plus the nonlinear solve's and rounding's share."""
+        fine = self._discrete(load, guess, coarse=False)
+        if not fine.converged:
+            return fine
+        coarse = self._discrete(load, fine, coarse=True)
+        if not coarse.converged:
+            return replace(fine, error_estimate=np.inf)
+        ratio = self._resolution(fine) / self._resolution(coarse)
+        order = self.finger.stiffness.order_cap(self.order)
+        est = richardson(fine, coarse, order, ratio) + self._solve_error(fine)
+        return replace(fine, error_estimate=est + rounding_floor(fine))
 
     @abstractmethod
-    def _solve(self, load: PointLoad, guess: BeamSolution) -> BeamSolution:
-        """Newton-type solve of one nonzero load from an initial guess."""
+    def _discrete(self, load: PointLoad, guess: BeamSolution, coarse: bool) -> BeamSolution:
+        """Newton solve of one nonzero load at the full (or half) resolution."""
+
+    @abstractmethod
+    def _resolution(self, sol: BeamSolution) -> float:
+        """Number of mesh steps a discrete solution used."""
+
+    def _solve_error(self, sol: BeamSolution) -> float:
+        """Load-point error left by the nonlinear solve (m); 0 where it converges to rounding."""
+        return 0.0
 
 
-def seed(finger: Finger, load: PointLoad, n: int = 201) -> BeamSolution:
-    """Initial guess: the Frisch-Fay primary branch of the compliance-equivalent uniform beam."""
+def seed(finger: Finger, load: PointLoad, n: int = 201, ei: float | None = None) -> BeamSolution:
+    """Initial guess: the Frisch-Fay primary branch of a uniform beam, by default
+    the one with the same small-deflection compliance."""
     from design.solve.beam.frisch_fay import FrischFay
 
-    ei = finger.stiffness.compliance_equivalent(load.at)
+    if ei is None:
+        ei = finger.stiffness.compliance_equivalent(load.at)
     uniform = Finger(finger.length, UniformEI(ei))
     return FrischFay(uniform, nodes=n).solve([load])[0]
 

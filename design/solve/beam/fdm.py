@@ -19,7 +19,7 @@ import numpy as np
 from scipy.linalg import solve_banded
 
 from design.physics.beam import BeamSolution, PointLoad, classify_branch
-from design.solve.beam.base import IterativeMethod, resample, richardson, rounding_floor
+from design.solve.beam.base import IterativeMethod, resample
 
 
 class FiniteDifference(IterativeMethod):
@@ -30,16 +30,12 @@ class FiniteDifference(IterativeMethod):
     default_nodes = 399
     max_iter = 60
 
-    def _solve(self, load: PointLoad, guess: BeamSolution) -> BeamSolution:
-        fine = self._solve_n(load, guess, self.nodes)
-        if not fine.converged:
-            return fine
-        n_coarse = max((self.nodes + 1) // 2 - 1, 2)
-        coarse = self._solve_n(load, fine, n_coarse)
-        ratio = (self.nodes + 1) / (n_coarse + 1)
-        est = richardson(fine, coarse, self.order, ratio) if coarse.converged else np.inf
-        est += rounding_floor(fine)
-        return BeamSolution(**{**fine.__dict__, "error_estimate": est})
+    def _discrete(self, load: PointLoad, guess: BeamSolution, coarse: bool) -> BeamSolution:
+        n = max((self.nodes + 1) // 2 - 1, 2) if coarse else self.nodes
+        return self._solve_n(load, guess, n)
+
+    def _resolution(self, sol: BeamSolution) -> float:
+        return sol.extras["N"] + 1
 
     def _solve_n(self, load: PointLoad, guess: BeamSolution, n: int) -> BeamSolution:
         L, alpha, force = load.at, load.alpha, load.force

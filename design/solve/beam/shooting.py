@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from design.physics.beam import BeamSolution, PointLoad, classify_branch
-from design.solve.beam.base import IterativeMethod, resample, richardson, rounding_floor
+from design.solve.beam.base import IterativeMethod, resample
 
 
 class Shooting(IterativeMethod):
@@ -31,15 +31,11 @@ class Shooting(IterativeMethod):
     default_nodes = 256
     max_iter = 50
 
-    def _solve(self, load: PointLoad, guess: BeamSolution) -> BeamSolution:
-        fine = self._solve_steps(load, guess, self.nodes)
-        if not fine.converged:
-            return fine
-        coarse = self._solve_steps(load, fine, max(self.nodes // 2, 2))
-        ratio = fine.extras["steps"] / coarse.extras["steps"]
-        est = richardson(fine, coarse, self.order, ratio) if coarse.converged else np.inf
-        est += rounding_floor(fine)
-        return BeamSolution(**{**fine.__dict__, "error_estimate": est})
+    def _discrete(self, load: PointLoad, guess: BeamSolution, coarse: bool) -> BeamSolution:
+        return self._solve_steps(load, guess, max(self.nodes // 2, 2) if coarse else self.nodes)
+
+    def _resolution(self, sol: BeamSolution) -> float:
+        return sol.extras["steps"]
 
     def _solve_steps(self, load: PointLoad, guess: BeamSolution, steps: int) -> BeamSolution:
         L, alpha = load.at, load.alpha
