@@ -67,8 +67,7 @@ class IterativeMethod(BeamMethod):
     def solve(self, loads: Sequence[PointLoad]) -> list[BeamSolution]:
         """Solve every load, in continuation order; results in the input order."""
         loads = list(loads)
-        order = sorted(range(len(loads)),
-                       key=lambda i: (loads[i].alpha, loads[i].at, loads[i].force))
+        order = continuation_order(loads)
         out: list[BeamSolution | None] = [None] * len(loads)
         prev: BeamSolution | None = None
         for i in order:
@@ -146,12 +145,19 @@ class IterativeMethod(BeamMethod):
         if not fine.converged:
             return fine
         coarse = self._discrete(load, fine, coarse=True)
-        if not coarse.converged:
+        return self._with_estimate(fine, (coarse.x[-1], coarse.y[-1]) if coarse.converged else None,
+                                   self._resolution(coarse))
+
+    def _with_estimate(self, fine: BeamSolution, coarse_tip: tuple[float, float] | None,
+                       coarse_resolution: float) -> BeamSolution:
+        """``fine`` with its error estimate from the load point (m) of a solve at
+        ``coarse_resolution`` (inf when that solve failed)."""
+        if coarse_tip is None:
             return replace(fine, error_estimate=np.inf)
-        ratio = self._resolution(fine) / self._resolution(coarse)
+        ratio = self._resolution(fine) / coarse_resolution
         order = self.finger.stiffness.order_cap(self.order)
-        est = richardson(fine, coarse, order, ratio) + self._solve_error(fine)
-        return replace(fine, error_estimate=est + rounding_floor(fine))
+        est = float(richardson((fine.x[-1], fine.y[-1]), coarse_tip, order, ratio))
+        return replace(fine, error_estimate=est + self._solve_error(fine) + rounding_floor(fine))
 
     @abstractmethod
     def _discrete(self, load: PointLoad, guess: BeamSolution, coarse: bool) -> BeamSolution:
@@ -164,6 +170,11 @@ class IterativeMethod(BeamMethod):
     def _solve_error(self, sol: BeamSolution) -> float:
         """Load-point error left by the nonlinear solve (m); 0 where it converges to rounding."""
         return 0.0
+
+
+def continuation_order(loads: Sequence[PointLoad]) -> list[int]:
+    """Indices of ``loads`` grouped by direction and position, force increasing."""
+    return sorted(range(len(loads)), key=lambda i: (loads[i].alpha, loads[i].at, loads[i].force))
 
 
 def seed(finger: Finger, load: PointLoad, n: int = 201, ei: float | None = None) -> BeamSolution:
@@ -183,16 +194,17 @@ def resample(sol: BeamSolution, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.interp(u, un, sol.psi), np.interp(u, un, sol.moment)
 
 
-def richardson(fine: BeamSolution, coarse: BeamSolution, order: int, ratio: float = 2.0) -> float:
-    """Load-point error estimate of ``fine`` from a coarser solution (m).
+def richardson(fine_tip, coarse_tip, order: int, ratio: float = 2.0):
+    """Load-point error estimate (m) of a solution from a coarser one's
+    (tips as (x, y); arrays of tips give an array of estimates).
 
     |tip_fine - tip_coarse| / (r^p - 1) for a method of order p and mesh
     ratio r: the asymptotic error of the finer solution, times a safety
     factor 2 against pre-asymptotic meshes.
     """
-    dx = fine.x[-1] - coarse.x[-1]
-    dy = fine.y[-1] - coarse.y[-1]
-    return float(2.0 * np.hypot(dx, dy) / (ratio ** order - 1))
+    dx = fine_tip[0] - coarse_tip[0]
+    dy = fine_tip[1] - coarse_tip[1]
+    return 2.0 * np.hypot(dx, dy) / (ratio ** order - 1)
 
 
 def rounding_floor(sol: BeamSolution) -> float:

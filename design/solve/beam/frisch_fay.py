@@ -211,6 +211,20 @@ def secondary_threshold(alpha: np.ndarray, iterations: int = 60) -> np.ndarray:
 TINY_KL = 1e-2
 
 
+def reverse_branch_exists(kl: np.ndarray, alpha: np.ndarray) -> np.ndarray:
+    """Whether a uniform beam has a second, reverse-bent equilibrium (per load).
+
+    ``kl`` = L sqrt(F/EI); ``alpha`` the load direction (any sign).
+    """
+    kl, a_abs = np.asarray(kl, dtype=float), np.abs(np.asarray(alpha, dtype=float))
+    out = np.zeros(kl.shape, dtype=bool)
+    may_fold = (kl > np.pi / 2) & (a_abs < np.pi)
+    if may_fold.any():     # the threshold depends on α only: once per distinct α
+        angles, inverse = np.unique(a_abs[may_fold], return_inverse=True)
+        out[may_fold] = kl[may_fold] >= secondary_threshold(angles)[inverse]
+    return out
+
+
 class FrischFay(BeamMethod):
     """Closed-form uniform elastica; vectorised over loads (``nodes``: shape points).
 
@@ -221,7 +235,7 @@ class FrischFay(BeamMethod):
 
     name = "frisch-fay"
     order = None
-    default_nodes = 41
+    default_nodes = 21
 
     def check(self) -> list[str]:
         if not self.finger.stiffness.uniform:
@@ -247,9 +261,7 @@ class FrischFay(BeamMethod):
         # their error grows like eps/kL for tiny loads (measured: 4e-15 m at kL = 0.01)
         klb = kl[bent]
         err = (step * np.minimum(d, psi0) + 64 * _EPS * (1 + klb + 1 / klb)) * at[bent]
-        may_fold = kl[bent] > np.pi / 2
-        second = np.zeros(d.shape, dtype=bool)
-        second[may_fold] = kl[bent][may_fold] >= secondary_threshold(a_abs[bent][may_fold])
+        second = reverse_branch_exists(kl[bent], a_abs[bent])
         out, j = [], 0
         for i, ld in enumerate(loads):
             if tiny[i]:

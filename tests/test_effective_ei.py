@@ -1,0 +1,48 @@
+"""Effective EI (MODEL.md §2.3, thesis §2.4.3 and Table 5-2)."""
+
+import numpy as np
+import pytest
+
+from design.physics.beam import PointLoad
+from design.solve.effective_ei import THESIS_CALIBRATION, effective_ei, effective_ei_table
+from tests.problems import HARD_E, table_2_3, thesis_finger, uniform_finger
+
+
+def test_table_2_3_effective_ei():
+    """MODEL.md: slope matching ≈ 0.054 N m^2, x1.48 ≈ 0.080 (thesis: 0.081),
+    position matching ≈ 0.079, for Table 2-3's load."""
+    finger, load = table_2_3()
+    e = effective_ei(finger, load)
+    assert e.slope_matched == pytest.approx(0.054, abs=5e-4)
+    assert e.thesis == pytest.approx(THESIS_CALIBRATION * e.slope_matched)
+    # the thesis prints 0.081 (two digits): ours is 0.0800
+    assert e.thesis == pytest.approx(0.081, abs=1.5e-3)
+    assert e.position_matched == pytest.approx(0.079, abs=1e-3)
+    # the position-matched stand-in is the closest uniform beam by construction,
+    # and the raw slope match is far off (why the thesis needed its factor)
+    assert e.distance_position_matched <= e.distance_thesis <= e.distance_slope_matched
+    assert e.distance_slope_matched > 5 * e.distance_position_matched
+
+
+def test_uniform_finger_is_its_own_effective_ei():
+    finger = uniform_finger(0.08)
+    e = effective_ei(finger, PointLoad(15.0, 1.2, 0.12))
+    assert e.slope_matched == pytest.approx(0.08, rel=1e-9)
+    assert e.position_matched == pytest.approx(0.08, rel=1e-6)
+    assert e.distance_position_matched < 1e-9
+
+
+def test_table_5_2_trend_soft_and_hard():
+    """Table 5-2: effective EI falls as the contact moves out (soft: 0.1108 at
+    50.8 mm ... 0.0506 at 127 mm), and the hard finger is 9.07/4.8 = 1.89x the
+    soft one. The thesis averaged over 'a range of forces and angles' it does
+    not list; at 15 N transverse the position match gives 0.1107 at 50.8 mm."""
+    positions = [0.0508, 0.06604, 0.08128, 0.09653, 0.11176, 0.127]
+    soft = effective_ei_table(thesis_finger(), positions, 15.0, np.pi / 2)
+    hard = effective_ei_table(thesis_finger(HARD_E), positions, 15.0 * HARD_E / 4.8e6, np.pi / 2)
+    ei_soft = np.array([r.position_matched for r in soft])
+    assert np.all(np.diff(ei_soft) < 0)
+    assert ei_soft[0] == pytest.approx(0.1108, rel=0.01)
+    # scaling E and F together leaves the shape unchanged: EI scales with E exactly
+    ratio = np.array([r.position_matched for r in hard]) / ei_soft
+    np.testing.assert_allclose(ratio, HARD_E / 4.8e6, rtol=1e-6)

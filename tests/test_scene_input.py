@@ -1,0 +1,142 @@
+"""Bad input: one clear message per problem, naming the file, the field and the
+accepted range; exit status 2; nothing written (issue 2, item 6)."""
+
+import json
+from pathlib import Path
+
+import pytest
+import yaml
+
+import design
+from design.cli import main
+from design.errors import ProblemFileError
+
+ROOT = Path(__file__).resolve().parents[1]
+GOOD = {"kind": "beam", "finger": {"length": 0.2, "EI": 0.08},
+        "load": {"F": 15, "alpha": 1.5707963, "at": 0.1}, "solver": {"method": "collocation"}}
+
+
+def write(tmp_path: Path, content: dict, name: str = "scene.yaml") -> Path:
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(content))
+    return path
+
+
+def with_changes(**sections) -> dict:
+    """GOOD with sections merged (load, solver) or replaced (finger, other keys)."""
+    scene = json.loads(json.dumps(GOOD))
+    for section, change in sections.items():
+        if section in ("load", "solver"):
+            scene[section].update(change)
+        else:
+            scene[section] = change
+    return scene
+
+
+EXPONENTIAL = {"type": "exponential", "A": 7.3e-8, "B": -3.6551e-8, "C": 3.2102e-9,
+               "a": -70.87, "b": -141.73}
+
+BAD = {
+    "negative EI": (with_changes(finger={"length": 0.2, "EI": -0.08}), "finger.EI",
+                    "(0, inf) N m^2"),
+    "zero EI": (with_changes(finger={"length": 0.2, "EI": 0}), "finger.EI", "(0, inf)"),
+    "negative E": (with_changes(finger={"length": 0.2, "E": -4.8e6,
+                                        "I": {"type": "uniform", "value": 1e-8}}),
+                   "finger.E", "(0, inf) Pa"),
+    "zero length": (with_changes(finger={"length": 0, "EI": 0.08}), "finger.length", "(0, inf) m"),
+    "negative length": (with_changes(finger={"length": "-3 in", "EI": 0.08}), "finger.length",
+                        "(0, inf) m"),
+    "load beyond finger": (with_changes(load={"at": 0.25}), "load.at", "(0, 0.2] m"),
+    "negative force": (with_changes(load={"F": [1, -2]}), "load.F[1]", "[0, inf) N"),
+    "unknown method": (with_changes(solver={"method": "newton"}), "solver.method",
+                       "small-deflection, frisch-fay, shooting, fdm, collocation"),
+    "unknown stiffness type": (with_changes(finger={"length": 0.2, "E": 4.8e6,
+                                                    "I": {"type": "conical", "value": 1e-8}}),
+                               "finger.I.type", "uniform, exponential, table"),
+    "malformed unit": (with_changes(load={"alpha": "90 degs"}), "load.alpha", "did you mean 'deg'"),
+    "wrong dimension": (with_changes(finger={"length": "0.2 N", "EI": 0.08}), "finger.length",
+                        "not a length"),
+    "unknown top-level key": (with_changes(colour="red"), "colour", "unknown key"),
+    "unknown load key": (with_changes(load={"angle": 1.0}), "load.angle", "unknown key"),
+    "misspelt solver key": (with_changes(solver={"node": 8}), "solver.node", "did you mean 'nodes'"),
+    "closed form on non-uniform finger": (
+        with_changes(finger={"length": 0.2, "E": 4.8e6, "I": EXPONENTIAL},
+                     solver={"method": "frisch-fay"}), "solver.method", "uniform EI"),
+    "both EI and E": (with_changes(finger={"length": 0.2, "EI": 0.08, "E": 4.8e6}), "finger.EI",
+                      "not both"),
+    "too few nodes": (with_changes(solver={"nodes": 1}), "solver.nodes", "[4, 200000]"),
+    "table not covering finger": (
+        with_changes(finger={"length": 0.2, "E": 4.8e6,
+                             "I": {"type": "table", "s": [0, 0.1], "I": [2e-8, 1e-8]}}),
+        "finger.I.s", "cover"),
+    "negative I in exponential fit": (
+        with_changes(finger={"length": 0.2, "E": 4.8e6, "I": {**EXPONENTIAL, "C": -3.2102e-8}}),
+        "finger.I", "not positive"),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_each_bad_input_is_one_clear_problem(tmp_path, capsys, case):
+    scene, field, accepted = BAD[case]
+    path = write(tmp_path, scene)
+    out = tmp_path / "out"
+    status = main(["simulate", str(path), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert status == 2
+    assert not out.exists()
+    problems = [line for line in err.splitlines() if line.startswith("error:")]
+    assert len(problems) == 1, err
+    assert f"{path}: {field}: " in problems[0] and accepted in problems[0], problems[0]
+
+
+def test_every_problem_reported_in_one_pass(tmp_path):
+    scene = with_changes(finger={"length": -1, "EI": 0.08}, load={"F": "3 furlongs", "colour": 1},
+                         solver={"method": "magic"})
+    with pytest.raises(ProblemFileError) as exc:
+        design.simulate(write(tmp_path, scene))
+    fields = sorted(p.field for p in exc.value.problems)
+    assert fields == ["finger.length", "load.F", "load.colour", "solver.method"]
+
+
+def test_problem_in_a_referenced_finger_file_names_that_file(tmp_path, capsys):
+    finger = tmp_path / "models" / "fingers" / "bad.yaml"
+    finger.parent.mkdir(parents=True)
+    finger.write_text("kind: finger\nlength: 0.2\nEI: -1\n")
+    scene = with_changes(finger="models/fingers/bad.yaml")
+    problems_dir = tmp_path / "problems"
+    problems_dir.mkdir()
+    path = write(problems_dir, scene)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{finger}: EI: -1 N m^2 is outside the accepted range (0, inf) N m^2" in err
+
+
+def test_missing_finger_file_and_bad_yaml(tmp_path, capsys):
+    path = write(tmp_path, with_changes(finger="models/fingers/none.yaml"))
+    assert main(["check", str(path)]) == 2
+    assert "finger file 'models/fingers/none.yaml' not found" in capsys.readouterr().err
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("kind: beam\nfinger: [1, 2\n")
+    assert main(["check", str(broken)]) == 2
+    assert "not valid YAML at line" in capsys.readouterr().err
+    empty = tmp_path / "empty.yaml"
+    empty.write_text("")
+    assert main(["check", str(empty)]) == 2
+    assert "the file is empty" in capsys.readouterr().err
+
+
+def test_shipped_models_and_problems_are_valid(capsys):
+    files = sorted(str(p) for p in [*ROOT.glob("models/**/*.yaml"), *ROOT.glob("problems/*.yaml")])
+    assert files
+    assert main(["check", *files]) == 0, capsys.readouterr().err
+
+
+def test_units_in_scene_files(tmp_path):
+    scene = {"kind": "beam", "finger": {"length": "8 in", "E": "4.8 MPa",
+                                        "I": {"type": "uniform", "value": "1.6667e-8 m^4"}},
+             "load": {"F": "15 N", "alpha": "90 deg", "at": "4 in"},
+             "solver": {"method": "frisch-fay"}}
+    result = design.simulate(write(tmp_path, scene))
+    case = result["cases"][0]
+    assert case["at"] == pytest.approx(0.1016) and case["alpha"] == pytest.approx(1.5707963267948966)
+    assert case["tip"]["y"] == pytest.approx(0.049184, abs=2e-5)   # EI = 0.0800016
