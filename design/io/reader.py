@@ -68,10 +68,8 @@ class Reader:
         allowed = required + optional
         for key in value:
             if key not in allowed:
-                hint = difflib.get_close_matches(str(key), allowed, n=1)
-                extra = f"; did you mean '{hint[0]}'?" if hint else ""
                 self.add(join(field, str(key)),
-                         f"unknown key (allowed: {', '.join(allowed)}){extra}")
+                         f"unknown key (allowed: {', '.join(allowed)}){did_you_mean(key, allowed)}")
         for key in required:
             if key not in value:
                 self.add(join(field, key), "required but missing")
@@ -112,6 +110,34 @@ class Reader:
         value = self._scalar(raw, path, dimension, lo, hi, lo_open, hi_open)
         return None if value is None else [value]
 
+    def vectors(self, data: Mapping, key: str, field: str, dimension: str, size: int = 2, *,
+                default: object = REQUIRED) -> list[tuple[float, ...]] | None:
+        """Read one vector ``[x, y]`` or a list of them (a sequence of poses)."""
+        path = join(field, key)
+        if key not in data:
+            if default is REQUIRED:
+                self.add(path, "required but missing")
+                return None
+            return default  # type: ignore[return-value]
+        raw = data[key]
+        if isinstance(raw, list) and raw and not isinstance(raw[0], list):
+            raw = [raw]
+        if not isinstance(raw, list) or not raw:
+            self.add(path, f"expected [x, y] or a list of [x, y], got {_kind(raw)}")
+            return None
+        out = []
+        for i, item in enumerate(raw):
+            where = path if len(raw) == 1 else join(path, i)
+            if not isinstance(item, list) or len(item) != size:
+                self.add(where, f"expected a list of {size} numbers, got {_kind(item)}")
+                return None
+            values = [self._scalar(v, join(where, j), dimension, None, None, False, False)
+                      for j, v in enumerate(item)]
+            if any(v is None for v in values):
+                return None
+            out.append(tuple(values))
+        return out
+
     def choice(self, data: Mapping, key: str, field: str, options: Iterable[str],
                default: object = REQUIRED) -> str | None:
         """Read a string that must be one of ``options``."""
@@ -124,9 +150,8 @@ class Reader:
             return default  # type: ignore[return-value]
         value = data[key]
         if value not in options:
-            hint = difflib.get_close_matches(str(value), options, n=1)
-            extra = f"; did you mean '{hint[0]}'?" if hint else ""
-            self.add(path, f"'{value}' is not one of: {', '.join(options)}{extra}")
+            self.add(path, f"'{value}' is not one of: {', '.join(options)}"
+                           f"{did_you_mean(value, options)}")
             return None
         return value
 
@@ -191,6 +216,15 @@ class Reader:
                            f"{interval(lo, hi, lo_open, hi_open)}{suffix}")
             return None
         return value
+
+
+def did_you_mean(given: object, allowed: list[str]) -> str:
+    """'; did you mean 'x'?' for a close spelling or a name containing the given one."""
+    text = str(given)
+    hint = difflib.get_close_matches(text, allowed, n=1)
+    if not hint:
+        hint = [a for a in allowed if text and (text in a or a in text)][:1]
+    return f"; did you mean '{hint[0]}'?" if hint else ""
 
 
 def _kind(value: object) -> str:

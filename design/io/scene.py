@@ -11,6 +11,7 @@ from pathlib import Path
 
 from design.errors import ProblemFileError
 from design.io.beam_scene import read_beam
+from design.io.contact_scene import read_contact
 from design.io.fingers import read_finger
 from design.io.files import load_yaml
 from design.io.reader import Reader
@@ -18,6 +19,8 @@ from design.io.reader import Reader
 #: kind -> (required top-level keys, optional top-level keys, reader)
 KINDS = {
     "beam": (("finger", "load"), ("solver",), read_beam),
+    "contact": (("finger", "drum", "finger_angle", "object", "friction"),
+                ("sliding", "motion", "solver"), read_contact),
 }
 MODEL_KINDS = ("finger",)
 _COMMON = ("kind", "name", "description")

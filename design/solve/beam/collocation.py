@@ -195,7 +195,8 @@ class BeamTranscription:
             self._cache[key] = ca.rootfinder(
                 "beam_newton", "newton", self.residual,
                 {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": False,
-                 "line_search": line_search, "linear_solver": "qr"})
+                 "line_search": line_search, "linear_solver": "qr",
+                 "show_eval_warnings": False})
         return self._cache[key]
 
     def chain(self, n: int, parts: int = 1, tolerance: float = 1e-13) -> ca.Function:

@@ -1,0 +1,149 @@
+"""One finger against the object's cross-section, in the finger's plane (thesis ch. III).
+
+Conventions. The finger base is on the drum at radius r and angle φ (world
+frame at the drum centre); the drum turns clockwise for ω > 0, φ = φ0 - ω t.
+Forces are on the object unless named otherwise; the force on the finger is
+F(-cos α, sin α) in the finger frame (as for the beam).
+
+Two independent choices describe a frictional contact:
+
+* the *side*: ``push`` when the object deflects the finger towards +y_f
+  (the finger pushes the object along its sweep for ω > 0), ``pull`` when
+  towards -y_f (thesis §4.3.3 defines push and pull this way);
+* the *friction sense* on the finger: ``tipward`` (the thesis's eq. 3.7:
+  α + ψ0 = π/2 + atan µ for push) or ``baseward``, opposite to the finger's
+  sliding over the object's surface.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from design.physics.ellipse import Ellipse, rotation
+
+SIDES = {"push": 1, "pull": -1}
+FRICTION_SENSES = {"tipward": 1, "baseward": -1, "none": 0}
+
+
+@dataclass(frozen=True)
+class FingerPose:
+    """Where a finger's base is: drum radius (m) and angle φ (rad)."""
+
+    radius: float
+    angle: float
+
+    @property
+    def base(self) -> np.ndarray:
+        """Base point in the world (drum-centre) frame, m."""
+        return self.radius * np.array([np.cos(self.angle), np.sin(self.angle)])
+
+    def to_world(self, x, y) -> np.ndarray:
+        """Finger-frame points to world, shape (2, ...)."""
+        pts = rotation(self.angle) @ np.stack([np.atleast_1d(x), np.atleast_1d(y)])
+        return pts + self.base[:, None]
+
+    def vector_to_world(self, v) -> np.ndarray:
+        return rotation(self.angle) @ np.asarray(v, float)
+
+    def view(self, ellipse: Ellipse) -> Ellipse:
+        """A world-frame ellipse seen in this finger's frame."""
+        return ellipse.in_frame(self.base, self.angle)
+
+
+@dataclass(frozen=True)
+class Motion:
+    """Rates that decide the sliding direction: drum speed ω (rad/s, > 0
+    clockwise), the object's velocity (m/s, world) and spin (rad/s)."""
+
+    drum_speed: float
+    object_velocity: tuple[float, float] = (0.0, 0.0)
+    object_spin: float = 0.0
+
+
+@dataclass(frozen=True)
+class ContactSolution:
+    """The quasi-static state of one finger at one pose.
+
+    Positions in m, force in N, angles in rad. ``point``/``psi``/``alpha``
+    are in the finger frame; ``shape_*`` cover the whole finger (the loaded
+    part, then the straight rest). ``penetration`` is the deepest point of
+    the finger inside the object (m, 0 when none).
+    """
+
+    contact: bool
+    force: float
+    alpha: float
+    arc_length: float
+    point: tuple[float, float]
+    psi: float
+    tip_contact: bool
+    side: str | None
+    friction: str
+    pose: FingerPose
+    shape_s: np.ndarray
+    shape_x: np.ndarray
+    shape_y: np.ndarray
+    converged: bool
+    iterations: int = 0
+    message: str = ""
+    penetration: float = 0.0
+    extras: dict = field(default_factory=dict)
+
+    @property
+    def force_on_object_finger_frame(self) -> np.ndarray:
+        """Force on the object in the finger frame, N (minus the force on the finger)."""
+        return self.force * np.array([np.cos(self.alpha), -np.sin(self.alpha)])
+
+    @property
+    def force_vector(self) -> np.ndarray:
+        """Force on the object in the world frame, N."""
+        return self.pose.vector_to_world(self.force_on_object_finger_frame)
+
+    @property
+    def point_world(self) -> np.ndarray:
+        return self.pose.to_world(*self.point)[:, 0]
+
+    @property
+    def shape_world(self) -> np.ndarray:
+        return self.pose.to_world(self.shape_x, self.shape_y)
+
+
+def no_contact(pose: FingerPose, length: float, message: str, converged: bool = True,
+               n: int = 2) -> ContactSolution:
+    """The undeflected finger: nothing touches it."""
+    s = np.linspace(0.0, length, n)
+    return ContactSolution(False, 0.0, 0.0, 0.0, (np.nan, np.nan), 0.0, False, None, "none",
+                           pose, s, s.copy(), np.zeros_like(s), converged, message=message)
+
+
+def segment_overlap(ellipse: Ellipse, length: float) -> float:
+    """min over the undeflected finger (0 ≤ x ≤ l, y = 0) of the level function;
+    < 0 when the straight finger would pass through the object."""
+    B, c = ellipse.matrix, np.asarray(ellipse.center)
+    # f(x, 0) = B00 (x - cx)^2 - 2 B01 (x - cx) cy + B11 cy^2 - 1: a parabola in x
+    x_star = c[0] + B[0, 1] * c[1] / B[0, 0]
+    xs = np.array([0.0, length, np.clip(x_star, 0.0, length)])
+    return float(np.min(ellipse.level(xs, np.zeros(3))))
+
+
+def grazing(ellipse: Ellipse, length: float, side: int) -> tuple[float, float] | None:
+    """How far the object must move to -side·y_f for the straight finger to
+    just touch it, and where: (shift δ ≥ 0 in m, x of the touching point).
+
+    For side = +1 the object lies towards -y_f and δ = max over the finger of
+    the ellipse's upper boundary y_hi(x); for side = -1 the mirror. None when
+    the finger's span does not reach the ellipse's x-range at all.
+    """
+    e = ellipse if side > 0 else ellipse.mirrored()
+    x_lo, x_hi = e.x_range()
+    lo, hi = max(0.0, x_lo), min(length, x_hi)
+    if lo > hi:
+        return None
+    th, a, b = e.theta, e.a, e.b
+    t_top = np.arctan2(b * np.cos(th), a * np.sin(th))
+    x_top = e.center[0] + a * np.cos(t_top) * np.cos(th) - b * np.sin(t_top) * np.sin(th)
+    x_g = float(np.clip(x_top, lo, hi))     # y_hi is concave in x
+    y_top = e.y_range_at(x_g)[1]
+    return float(y_top), x_g

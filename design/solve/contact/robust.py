@@ -1,0 +1,452 @@
+"""The default contact solver: continuation from first touch, no tuning.
+
+A contact state is the root of :mod:`design.solve.contact.equations` in one
+of two modes (contact inside the span, or at the tip). Newton from a poor
+guess is what made the thesis's Algorithm II land on spurious solutions,
+so this solver never starts from a guess it cannot justify:
+
+1. If the straight finger misses the object, there is no contact (F = 0):
+   an unloaded finger is then an equilibrium and the one continued from
+   before contact.
+2. Otherwise the object is moved back, away from the finger along y_f,
+   until the straight finger just grazes it. There the solution is known
+   exactly (F = 0, straight finger, contact at the grazing point). The
+   object is then moved forward to its real place in steps that halve on
+   failure and double on success: every step starts inside Newton's
+   convergence region of the continued solution.
+3. After every step the mode is checked and switched where it no longer
+   holds: a contact point that reaches the tip becomes tip contact; a tip
+   whose finger turns tangent to the surface becomes interior contact; a
+   force that would pull the finger into the object is a release.
+4. Along a pass (a sequence of poses) each pose continues from the previous
+   one the same way, so the solution followed is the physically continued
+   one.
+
+Friction. With ``sliding: push`` or ``pull`` the side is imposed and the
+friction on the finger points tipwards, as in the thesis. With ``auto``,
+the side is the one from which the object meets the finger, and the
+friction opposes the finger's sliding over the surface: the velocity of
+the finger's material point at the contact (drum rotation plus the rate
+of deflection, by the implicit-function theorem on the contact equations)
+minus the object's surface velocity. If both senses contradict their own
+sliding velocity, the contact sticks: the friction ratio in (-µ, µ) that
+makes the sliding velocity zero is found by bisection.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from design.physics.beam import Finger, PointLoad, straight_solution
+from design.physics.contact import (SIDES, ContactSolution, FingerPose, Motion, grazing,
+                                    no_contact, segment_overlap)
+from design.physics.ellipse import Ellipse, rotation
+from design.solve.beam.collocation import adapted_widths
+from design.solve.contact.equations import MODES, contact_transcription
+
+#: |penetration| below this (m) is rounding, not a second contact
+PENETRATION_TOL = 1e-9
+#: contact closer to the base than this fraction of the finger is outside the
+#: model: the object is pressed against the drum
+BASE_FRACTION = 0.01
+BASE_REACHED = ("the contact reached the finger's base (within 1% of its length): the object "
+                "presses on the drum, outside the finger model")
+#: sliding speeds below this (m/s) count as sticking
+STICK_SPEED = 1e-7
+#: a continuation step whose Newton solve needs more iterations than this is
+#: halved: it started too far from the continued solution
+MAX_STEP_ITERATIONS = 12
+
+
+@dataclass
+class _State:
+    """A solved contact: mode, unknowns, and the parameters they solve."""
+
+    mode: str
+    z: np.ndarray
+    ellipse: Ellipse
+    tau_mu: float
+    side: int
+
+
+class RobustContact:
+    """Continuation contact solver on the collocated non-uniform beam.
+
+    Parameters
+    ----------
+    finger : Finger
+    friction : float
+        Coefficient of friction µ between finger and object (≥ 0).
+    intervals, degree : int
+        Beam collocation mesh (see :class:`~design.solve.beam.collocation.Collocation`).
+    tolerance : float
+        Newton tolerance on the dimensionless residual.
+    """
+
+    name = "robust"
+
+    def __init__(self, finger: Finger, friction: float, intervals: int = 10, degree: int = 4,
+                 tolerance: float = 1e-12, max_steps: int = 400):
+        self.finger = finger
+        self.mu = float(friction)
+        self.intervals, self.degree = intervals, degree
+        self.tolerance = tolerance
+        self.max_steps = max_steps
+        stiff = finger.stiffness
+        self.ei_ref = stiff.compliance_equivalent(finger.length)
+        straight = straight_solution(PointLoad(0.0, 0.0, finger.length), "", 3)
+        self.widths = adapted_widths(intervals, stiff, [straight])
+        self.tr = {m: contact_transcription(stiff, intervals, degree, m) for m in MODES}
+        self.newton_iterations = 0
+        self._last_iterations = 0
+
+    # ----------------------------------------------------------------- API
+    def solve(self, pose: FingerPose, ellipse: Ellipse, sliding: str = "auto",
+              motion: Motion | None = None) -> ContactSolution:
+        """Contact state of the finger at ``pose`` against the world-frame ``ellipse``.
+
+        With ``sliding: auto`` and a motion, friction makes the state depend on
+        its history: the motion is played back to the moment of first touch and
+        the contact followed from there (every 1° of drum rotation).
+        """
+        if sliding == "auto" and motion is not None and self.mu > 0:
+            history = self._history(pose, ellipse, motion)
+            if history:
+                sols = self.solve_pass([h[0] for h in history] + [pose],
+                                       [h[1] for h in history] + [ellipse], sliding, motion)
+                return sols[-1]
+        return self._solve(pose, ellipse, sliding, motion, None)[0]
+
+    def _history(self, pose: FingerPose, ellipse: Ellipse, motion: Motion,
+                 step: float = np.radians(1.0)) -> list[tuple[FingerPose, Ellipse]]:
+        """Earlier poses, from the last one before first touch up to (not
+        including) now, following the motion backwards; [] if the object was
+        touching for more than half a drum turn or nothing moves."""
+        omega = motion.drum_speed
+        speed = float(np.hypot(*motion.object_velocity))
+        if omega != 0.0:
+            dt = step / abs(omega)
+        elif speed > 0.0:
+            dt = 0.002 * self.finger.length / speed
+        else:
+            return []
+        back = []
+        for k in range(1, int(np.pi / step) + 2):
+            t = -k * dt
+            p = FingerPose(pose.radius, pose.angle - omega * t)
+            c = np.asarray(ellipse.center) + np.asarray(motion.object_velocity) * t
+            e = Ellipse(ellipse.a, ellipse.b, (float(c[0]), float(c[1])),
+                        ellipse.theta + motion.object_spin * t)
+            back.append((p, e))
+            if segment_overlap(p.view(e), self.finger.length) >= 0.0:
+                return back[::-1]
+        return []
+
+    def solve_pass(self, poses: list[FingerPose], ellipses: list[Ellipse],
+                   sliding: str = "auto", motion: Motion | None = None,
+                   progress=None) -> list[ContactSolution]:
+        """A sequence of poses, each continued from the previous solution."""
+        out, state = [], None
+        for i, (pose, ellipse) in enumerate(zip(poses, ellipses)):
+            sol, state = self._solve(pose, ellipse, sliding, motion, state)
+            out.append(sol)
+            if progress and (i + 1) % 50 == 0:
+                progress(f"contact pass: {i + 1}/{len(poses)} poses")
+        return out
+
+    # ----------------------------------------------------------- one pose
+    def _solve(self, pose, ellipse_w, sliding, motion, previous: _State | None):
+        self.newton_iterations = 0
+        length = self.finger.length
+        ell = pose.view(ellipse_w)
+        if ell.level(0.0, 0.0) <= 0.0:
+            return no_contact(pose, length, "the finger base is inside the object: invalid pose",
+                              converged=False), None
+        if segment_overlap(ell, length) >= 0.0:
+            return no_contact(pose, length, "the straight finger misses the object"), None
+        side = self._side(ell, pose, ellipse_w, sliding, motion, previous)
+        tau_mu = self._initial_tau_mu(sliding, previous, ell, side, pose, ellipse_w, motion)
+        if previous is not None and previous.side == side:
+            state, msg = self._continue(previous, ell, tau_mu)
+            if state is None and msg != BASE_REACHED:
+                # the continued equilibrium ended (a fold): the finger snaps to
+                # another one, found afresh from first touch
+                state, msg2 = self._from_grazing(ell, side, tau_mu)
+                msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
+                      f"first touch" if state is not None else msg2
+        else:
+            state, msg = self._from_grazing(ell, side, tau_mu)
+        if state is None:
+            return no_contact(pose, length, msg, converged=False), None
+        friction, v_slide = self._friction_label(tau_mu), None
+        if sliding == "auto" and motion is not None and self.mu > 0:
+            state, friction, msg2, v_slide = self._settle_friction(state, pose, ellipse_w, motion)
+            msg = "; ".join(m for m in (msg, msg2) if m)
+        if state is None:
+            return no_contact(pose, length, msg, converged=False), None
+        sol = self._solution(state, pose, friction, msg)
+        sol.extras["sliding_velocity"] = v_slide
+        return sol, state
+
+    def _side(self, ell, pose, ellipse_w, sliding, motion, previous) -> int:
+        """+1 (push: finger deflected to +y_f) or -1 (pull)."""
+        if sliding in SIDES:
+            return SIDES[sliding]
+        if previous is not None:
+            return previous.side
+        if motion is not None:
+            # the object meets the finger from the side it approaches from
+            up, down = grazing(ell, self.finger.length, +1), grazing(ell, self.finger.length, -1)
+            x_g = (up or down)[1]
+            p_w = pose.to_world(x_g, 0.0)[:, 0]
+            v_rel = _object_velocity(p_w, ellipse_w, motion) - _rigid_velocity(p_w, motion)
+            v_y = float(rotation(pose.angle).T @ v_rel @ np.array([0.0, 1.0]))
+            if abs(v_y) > 1e-12:
+                return 1 if v_y > 0 else -1
+        # otherwise: the side the finger has to bend less to clear the object
+        up, down = grazing(ell, self.finger.length, +1), grazing(ell, self.finger.length, -1)
+        return 1 if up[0] <= down[0] else -1
+
+    def _initial_tau_mu(self, sliding, previous, ell, side, pose, ellipse_w, motion) -> float:
+        if self.mu == 0.0:
+            return 0.0
+        if sliding in SIDES or motion is None:
+            return self.mu          # the thesis's convention: friction on the finger tipwards
+        if previous is not None:
+            return previous.tau_mu
+        return self.mu              # refined by _settle_friction once the contact is solved
+
+    # ------------------------------------------------------- continuation
+    def _from_grazing(self, ell: Ellipse, side: int, tau_mu: float):
+        """Move the object back until the straight finger grazes it, then forward."""
+        graze = grazing(ell, self.finger.length, side)
+        if graze is None:
+            return None, "the finger cannot reach the object"
+        shift, x_g = graze
+        start = ell.shifted(0.0, -side * shift)
+        length = self.finger.length
+        if x_g <= 1e-9 * length:
+            return None, "the object reaches the finger at its base: no bending contact"
+        if x_g < length * (1 - 1e-12):
+            mode, z_extra = "interior", [x_g / length]
+            t_c = np.array([1.0, 0.0])
+            normal = np.array([0.0, side])
+        else:
+            mode, z_extra = "tip", []
+            g = start.gradient(length, 0.0)
+            normal = g / np.hypot(*g)
+            t_c = np.array([1.0, 0.0]) - normal[0] * normal
+            t_c = t_c / np.hypot(*t_c) if np.hypot(*t_c) > 0 else np.array([1.0, 0.0])
+        e = normal + tau_mu * t_c
+        alpha = float(np.arctan2(e[1], -e[0]))
+        z = np.concatenate([np.zeros(self.tr[mode].beam.n_w), [0.0, alpha], z_extra])
+        state = _State(mode, z, start, tau_mu, side)
+        return self._continue(state, ell, tau_mu)
+
+    def _continue(self, state: _State, target: Ellipse, tau_mu: float):
+        """Continue ``state`` to the target ellipse and friction, in adaptive steps."""
+        src = state.ellipse
+        p0 = np.array([src.center[0], src.center[1], src.theta, state.tau_mu])
+        p1 = np.array([target.center[0], target.center[1],
+                       src.theta + _wrap(target.theta - src.theta), tau_mu])
+        t, step = 0.0, 1.0
+        for _ in range(self.max_steps):
+            if t >= 1.0:
+                return state, ""
+            t_new = min(1.0, t + step)
+            p = p0 + t_new * (p1 - p0)
+            ell = Ellipse(target.a, target.b, (p[0], p[1]), p[2])
+            new = self._step(state, ell, p[3])
+            if new is None:
+                step /= 2
+                if step < 1e-7:
+                    return None, f"continuation stalled at {t:.6f} of the step"
+                continue
+            if new == "base":
+                return None, BASE_REACHED
+            if new == "release":
+                # the object pulls away: contact is lost if the straight finger is clear
+                if segment_overlap(target, self.finger.length) >= 0.0:
+                    return None, "released"
+                step /= 2
+                if step < 1e-7:
+                    return None, "force would pull the finger into the object"
+                continue
+            state, t, step = new, t_new, min(2 * step, 1.0)
+        return None, f"no convergence in {self.max_steps} continuation steps"
+
+    def _step(self, state: _State, ell: Ellipse, tau_mu: float):
+        """Newton at new parameters from ``state``, with mode switches; None on failure."""
+        mode, z = state.mode, state.z
+        for _ in range(3):                         # at most: solve, switch, solve
+            z_new, ok, post = self._newton(mode, z, ell, tau_mu)
+            # a step must converge quickly and stay on its side: a long Newton
+            # run, or a finger bent the other way, means the step jumped branch
+            if not ok or self._last_iterations > MAX_STEP_ITERATIONS \
+                    or state.side * post[11] <= 0:
+                return None
+            verdict = self._check(mode, post)
+            if verdict == "ok":
+                return _State(mode, z_new, ell, tau_mu, state.side)
+            if verdict in ("release", "base"):
+                return verdict
+            if verdict == "tip":
+                mode, z = "tip", z_new[:-1]
+            else:                                  # tip turned tangent: contact moves inside
+                mode, z = "interior", np.concatenate([z_new, [1.0]])
+        return None
+
+    def _newton(self, mode, z0, ell, tau_mu):
+        tr = self.tr[mode]
+        q = tr.parameters(self.finger.length, self.ei_ref, ell, tau_mu, self.widths,
+                          self.finger.stiffness)
+        rf = tr.rootfinder(self.tolerance)
+        z = np.asarray(rf(z0, q)).ravel()
+        self._last_iterations = int(rf.stats().get("iter_count", 0))
+        self.newton_iterations += self._last_iterations
+        post, resid = (np.asarray(v).ravel() for v in tr.post(z, q))
+        ok = bool(rf.stats().get("success", False)) and np.isfinite(resid[0]) \
+            and resid[0] < 1e-8
+        if ok and post[3] < 0:                     # F < 0 with α is F > 0 with α + π
+            nw = tr.beam.n_w
+            z[nw], z[nw + 1] = -z[nw], z[nw + 1] + np.pi
+            post, _ = (np.asarray(v).ravel() for v in tr.post(z, q))
+        return z, ok, post
+
+    def _check(self, mode, post) -> str:
+        """'ok', 'tip' (interior contact passed the tip), 'interior' (tip turned
+        tangent), 'release' (the force would pull the finger in) or 'base'
+        (the contact reached the finger's base)."""
+        length, along, push = post[5], post[7], post[8]
+        if post[3] > 0 and push <= 0:
+            return "release"
+        if mode == "interior":
+            if length > self.finger.length * (1 + 1e-12):
+                return "tip"
+            return "ok" if length > BASE_FRACTION * self.finger.length else "base"
+        return "ok" if along <= 0 else "interior"
+
+    # ------------------------------------------------------------ friction
+    def _settle_friction(self, state, pose, ellipse_w, motion):
+        """Friction ratio m = τµ consistent with the sliding velocity v(m).
+
+        Physical states: sliding tipwards with the friction on the finger
+        baseward (m = -µ, v ≥ 0), the mirror (m = +µ, v ≤ 0), or sticking
+        (|m| < µ, v = 0). From the current m the ratio moves in the direction
+        that opposes the sliding, and stops where v vanishes (stick) or at
+        the bound (sliding the other way): the friction force is continued,
+        never flipped past a sticking state.
+        """
+        v = self._sliding_velocity(state, pose, ellipse_w, motion)
+        if self._consistent(state.tau_mu, v):
+            return state, self._friction_label(state.tau_mu), "", v
+        target = -self.mu if v > 0 else self.mu
+        end, msg = self._continue(state, state.ellipse, target)
+        if end is None:
+            # the equilibrium ends before the friction reaches the bound (a
+            # fold): look for the sliding state afresh from first touch
+            end, msg2 = self._from_grazing(state.ellipse, state.side, target)
+            if end is None:
+                return None, "none", f"no equilibrium with friction ratio {target:+g}: {msg}", None
+        v_end = self._sliding_velocity(end, pose, ellipse_w, motion)
+        if v_end * v > 0 or v_end == 0.0:          # still sliding the same way: at the bound
+            return end, self._friction_label(end.tau_mu), "", v_end
+        a, b, v_a = state, end, v                   # v changes sign in between: stick
+        for _ in range(60):
+            mid, msg = self._continue(a, a.ellipse, 0.5 * (a.tau_mu + b.tau_mu))
+            if mid is None:
+                break
+            v_mid = self._sliding_velocity(mid, pose, ellipse_w, motion)
+            if v_mid * v_a > 0:
+                a, v_a = mid, v_mid
+            else:
+                b = mid
+            if abs(v_a) <= STICK_SPEED or abs(b.tau_mu - a.tau_mu) < 1e-12 * self.mu:
+                break
+        return (a, "stick", f"sticking contact: friction ratio {a.tau_mu:+.4f} (µ = {self.mu:g})",
+                v_a)
+
+    def _consistent(self, tau_mu: float, v: float) -> bool:
+        if tau_mu >= self.mu * (1 - 1e-12):
+            return v <= 0
+        if tau_mu <= -self.mu * (1 - 1e-12):
+            return v >= 0
+        return abs(v) <= STICK_SPEED
+
+    def _sliding_velocity(self, state: _State, pose: FingerPose, ellipse_w: Ellipse,
+                          motion: Motion) -> float:
+        """Finger material point's velocity relative to the object's surface,
+        along the sliding tangent (m/s, + towards the finger tip)."""
+        tr = self.tr[state.mode]
+        q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
+                          self.widths, self.finger.stiffness)
+        jz, jq, jtip = (np.asarray(m) for m in tr.sensitivity(state.z, q))
+        post, _ = (np.asarray(v).ravel() for v in tr.post(state.z, q))
+        # rate of the ellipse parameters in the finger frame (cx, cy, θ)
+        omega = motion.drum_speed
+        c_w = np.asarray(ellipse_w.center, float)
+        rot_t = rotation(pose.angle).T
+        J = np.array([[0.0, -1.0], [1.0, 0.0]])
+        c_dot = omega * J @ rot_t @ c_w + rot_t @ np.asarray(motion.object_velocity, float)
+        q_dot = np.array([c_dot[0], c_dot[1], motion.object_spin + omega])
+        z_dot = np.linalg.lstsq(jz, -jq @ q_dot, rcond=None)[0]
+        x_dot, y_dot, l_dot = jtip @ z_dot
+        psi = post[2]
+        t_f = np.array([np.cos(psi), np.sin(psi)])
+        v_material_f = np.array([x_dot, y_dot]) - t_f * l_dot
+        p_w = pose.to_world(post[0], post[1])[:, 0]
+        v_finger = _rigid_velocity(p_w, motion) + rotation(pose.angle) @ v_material_f
+        v_rel = v_finger - _object_velocity(p_w, ellipse_w, motion)
+        t_c = rotation(pose.angle) @ post[9:11]
+        return float(v_rel @ t_c)
+
+    def _friction_label(self, tau_mu: float) -> str:
+        if self.mu == 0.0 or tau_mu == 0.0:
+            return "none"
+        return "tipward" if tau_mu > 0 else "baseward"
+
+    # -------------------------------------------------------------- output
+    def _solution(self, state: _State, pose: FingerPose, friction: str, msg: str
+                  ) -> ContactSolution:
+        tr = self.tr[state.mode]
+        q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
+                          self.widths, self.finger.stiffness)
+        post, resid = (np.asarray(v).ravel() for v in tr.post(state.z, q))
+        s, x, y, psi, moment = (np.asarray(v).ravel() for v in tr.shape(state.z, q))
+        x_l, y_l, psi_l, force, alpha, arc = post[:6]
+        length = self.finger.length
+        if arc < length:                           # the straight rest of the finger
+            rest = np.linspace(arc, length, 6)[1:]
+            s = np.concatenate([s, rest])
+            x = np.concatenate([x, x_l + (rest - arc) * np.cos(psi_l)])
+            y = np.concatenate([y, y_l + (rest - arc) * np.sin(psi_l)])
+        # the finger must not pass through the object anywhere but at the contact
+        depth = -np.min(state.ellipse.distance_outside(x, y))
+        penetration = float(max(depth, 0.0)) if depth > PENETRATION_TOL else 0.0
+        converged = penetration == 0.0
+        if not converged:
+            msg = "; ".join(m for m in (msg, f"the finger passes {penetration:.3g} m into the "
+                                             f"object away from the contact") if m)
+        return ContactSolution(
+            True, float(force), float(alpha), float(arc), (float(x_l), float(y_l)),
+            float(psi_l), state.mode == "tip", "push" if state.side > 0 else "pull", friction,
+            pose, s, x, y, converged, self.newton_iterations, msg, penetration,
+            extras={"residual": float(resid[0]), "friction_ratio": state.tau_mu,
+                    "mode": state.mode, "base_moment": float(moment[0])})
+
+
+def _wrap(angle: float) -> float:
+    return float((angle + np.pi) % (2 * np.pi) - np.pi)
+
+
+def _rigid_velocity(p_w: np.ndarray, motion: Motion) -> np.ndarray:
+    """Velocity of a point carried by the drum (clockwise for ω > 0), m/s."""
+    return motion.drum_speed * np.array([p_w[1], -p_w[0]])
+
+
+def _object_velocity(p_w: np.ndarray, ellipse_w: Ellipse, motion: Motion) -> np.ndarray:
+    """Velocity of the object's material point at p_w, m/s."""
+    r = p_w - np.asarray(ellipse_w.center, float)
+    return np.asarray(motion.object_velocity, float) + motion.object_spin * np.array([-r[1], r[0]])
