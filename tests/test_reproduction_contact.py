@@ -45,6 +45,22 @@ def test_case_2_is_a_pull(cases):
     assert sol.force == pytest.approx(force, rel=0.03)
 
 
+def test_effective_ei_stand_in_gets_the_force_not_the_contact_point(cases):
+    """Against a rigid object a uniform finger's contact geometry does not depend
+    on EI at all, so the effective-EI stand-in (position-matched to the soft
+    finger's contact load) touches where the EI = 0.08 finger does, 15-25 mm
+    from the non-uniform finger's contact; only its force comes close (≤ 15%)."""
+    for case in (1, 2):
+        soft = cases[(case, "robust, non-uniform soft")]
+        uniform = cases[(case, "robust, uniform EI = 0.08")]
+        stand_in = next(v for k, v in cases.items() if k[0] == case and "effective" in k[1]
+                        and "robust" in k[1])
+        assert stand_in.converged
+        np.testing.assert_allclose(stand_in.point, uniform.point, atol=1e-10)
+        assert np.hypot(*np.subtract(stand_in.point, soft.point)) > 0.01
+        assert stand_in.force == pytest.approx(soft.force, rel=0.15)
+
+
 def test_algorithm_two_equals_the_robust_solver_on_the_same_finger(cases):
     """Our implementation of the thesis's Algorithm II converges (N = 155) to the
     robust solver's answer on the non-uniform finger, within the FDM's O(h^2)."""
