@@ -15,13 +15,15 @@ from pathlib import Path
 
 from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
+from design.io.grasp_scene import GraspScene
 from design.io.results import write_outputs
 from design.io.scene import check_file, load_scene
 from design.run import Progress, RunOutput
 from design.run import beam as beam_run
 from design.run import contact as contact_run
+from design.run import grasp as grasp_run
 
-RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run}
+RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run, GraspScene: grasp_run.run}
 
 
 def run_scene(source: str | Path | Mapping, progress: Progress | None = None) -> RunOutput:

@@ -44,3 +44,29 @@ def resolve(reference: str, base_dir: Path) -> Path | None:
         if candidate.is_file():
             return candidate
     return None
+
+
+def read_model(reader: Reader, value: object, field: str, base_dir: Path, kind: str, parse):
+    """A model given inline (a mapping) or as a path to a model file.
+
+    ``parse(reader, data, field, base_dir, default_name)`` reads the mapping.
+    A file's problems are reported under its own name; its own references
+    resolve from its folder.
+    """
+    if isinstance(value, str):
+        path = resolve(value, base_dir)
+        if path is None:
+            reader.add(field, f"{kind} file '{value}' not found (looked in {base_dir}, its "
+                              f"parent folders, {Path.cwd()} and {TOOLKIT_ROOT})")
+            return None
+        sub = Reader(str(path))
+        data = load_yaml(path, sub)
+        model = None
+        if data is not None:
+            if isinstance(data, dict) and data.get("kind", kind) != kind:
+                sub.add("kind", f"'{data['kind']}' where a {kind} is expected")
+            else:
+                model = parse(sub, data, "", path.resolve().parent, path.stem)
+        reader.problems.extend(sub.problems)
+        return model
+    return parse(reader, value, field, base_dir, "")

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from design.io.files import TOOLKIT_ROOT, load_yaml, resolve
+from design.io.files import read_model
 from design.io.reader import Reader, join
 from design.physics.beam import Finger
 from design.physics.stiffness import ExponentialI, Stiffness, TableI, UniformEI
@@ -28,21 +28,11 @@ _FINGER_KEYS = ("length", "EI", "E", "I", "name", "description", "source", "kind
 
 def read_finger(reader: Reader, value: object, field: str, base_dir: Path) -> Finger | None:
     """A finger given inline (mapping) or as a path to a finger file."""
-    if isinstance(value, str):
-        path = resolve(value, base_dir)
-        if path is None:
-            reader.add(field, f"finger file '{value}' not found (looked in {base_dir}, "
-                              f"its parent folders, {Path.cwd()} and {TOOLKIT_ROOT})")
-            return None
-        sub = Reader(str(path))
-        data = load_yaml(path, sub)
-        finger = None if data is None else _finger(sub, data, "", default_name=path.stem)
-        reader.problems.extend(sub.problems)
-        return finger
-    return _finger(reader, value, field, default_name="")
+    return read_model(reader, value, field, base_dir, "finger", _finger)
 
 
-def _finger(reader: Reader, value: object, field: str, default_name: str) -> Finger | None:
+def _finger(reader: Reader, value: object, field: str, base_dir: Path,
+            default_name: str) -> Finger | None:
     data = reader.mapping(value, field, required=("length",), optional=_FINGER_KEYS[1:])
     if data is None:
         return None

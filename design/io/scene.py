@@ -12,6 +12,7 @@ from pathlib import Path
 from design.errors import ProblemFileError
 from design.io.beam_scene import read_beam
 from design.io.contact_scene import read_contact
+from design.io.grasp_scene import MODEL_READERS, read_grasp
 from design.io.fingers import read_finger
 from design.io.files import load_yaml
 from design.io.reader import Reader
@@ -21,8 +22,10 @@ KINDS = {
     "beam": (("finger", "load"), ("solver",), read_beam),
     "contact": (("finger", "drum", "finger_angle", "object", "friction"),
                 ("sliding", "motion", "solver"), read_contact),
+    "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
+              ("finger_models", "friction", "legs", "solver"), read_grasp),
 }
-MODEL_KINDS = ("finger",)
+MODEL_KINDS = ("finger", *MODEL_READERS)
 _COMMON = ("kind", "name", "description")
 
 
@@ -54,9 +57,13 @@ def check_file(source: str | Path | Mapping) -> object:
     """Validate any input file, scene or model; returns what it describes."""
     reader, data, base_dir, name = _open(source)
     if isinstance(data, Mapping) and data.get("kind") in MODEL_KINDS:
-        finger = read_finger(reader, dict(data), "", base_dir)
+        kind = data["kind"]
+        if kind == "finger":
+            model = read_finger(reader, dict(data), "", base_dir)
+        else:
+            model = MODEL_READERS[kind](reader, dict(data), "", base_dir, name)
         reader.raise_if_any()
-        return finger
+        return model
     reader.raise_if_any()
     return load_scene(source)
 

@@ -96,11 +96,11 @@ class ContactTranscription:
                         ca.dot(d, e) / ca.norm_2(e), t_c, ca.dot(normal, n_f)),
              ca.mmax(ca.fabs(R))])
         self.shape = ca.Function(f"contact_{mode}_shape", [z, q], beam.shape(w, P))
-        # implicit-function sensitivities: dz/d(cx, cy, θ) and d(x_L, y_L, L)/dz
+        # implicit-function sensitivities: dR/dz, dR/d(cx, cy, θ, a, b), d(x_L, y_L, L)/dz
         tip_l = ca.vertcat(x, y, L)
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
-            [ca.jacobian(R, z), ca.jacobian(R, q[2:5]), ca.jacobian(tip_l, z)])
+            [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
         self._rootfinders: dict = {}
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40) -> ca.Function:

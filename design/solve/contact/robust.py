@@ -36,6 +36,7 @@ makes the sliding velocity zero is found by bisection.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -55,6 +56,8 @@ BASE_REACHED = ("the contact reached the finger's base (within 1% of its length)
                 "presses on the drum, outside the finger model")
 #: sliding speeds below this (m/s) count as sticking
 STICK_SPEED = 1e-7
+#: Newton iterations per solve: a start inside the convergence region needs 3-6
+MAX_NEWTON_ITERATIONS = 20
 #: a continuation step whose Newton solve needs more iterations than this is
 #: halved: it started too far from the continued solution
 MAX_STEP_ITERATIONS = 12
@@ -69,6 +72,7 @@ class _State:
     ellipse: Ellipse
     tau_mu: float
     side: int
+    post: np.ndarray | None = None
 
 
 class RobustContact:
@@ -88,12 +92,20 @@ class RobustContact:
     name = "robust"
 
     def __init__(self, finger: Finger, friction: float, intervals: int = 10, degree: int = 4,
-                 tolerance: float = 1e-12, max_steps: int = 400):
+                 tolerance: float = 1e-12, max_steps: int = 400,
+                 reversal_speed: float | None = None):
         self.finger = finger
         self.mu = float(friction)
         self.intervals, self.degree = intervals, degree
         self.tolerance = tolerance
         self.max_steps = max_steps
+        #: None: Coulomb friction with exact stick (quasi-static passes). A speed
+        #: (m/s): friction always at the edge of sliding (the thesis's
+        #: assumption) and reversed only when the finger slides the other way
+        #: faster than this (the grasp dynamics, where an exact stick would tie
+        #: every finger's contact to the bird's acceleration, and reversing at
+        #: every sign change of a lagged sliding speed chatters)
+        self.reversal_speed = reversal_speed
         stiff = finger.stiffness
         self.ei_ref = stiff.compliance_equivalent(finger.length)
         straight = straight_solution(PointLoad(0.0, 0.0, finger.length), "", 3)
@@ -158,16 +170,34 @@ class RobustContact:
 
     # ----------------------------------------------------------- one pose
     def _solve(self, pose, ellipse_w, sliding, motion, previous: _State | None):
+        kin = None if motion is None else planar_kinematics(pose, ellipse_w, motion)
+        return self.solve_frame(pose.view(ellipse_w), sliding, kin, previous, pose)
+
+    def solve_frame(self, ell: Ellipse, sliding: str, kinematics: "Kinematics | None",
+                    previous: _State | None, pose: FingerPose = FingerPose(0.0, 0.0),
+                    settle: bool = True, detail: bool = True):
+        """Solve with the object already in the finger frame (the 3-D grasp's entry).
+
+        ``kinematics(p)`` gives, for a finger-frame point p, the rates of the
+        ellipse's parameters (cx, cy, θ, a, b) in the finger frame and the
+        object's material velocity at p relative to the finger frame; it
+        decides the side and the friction for ``sliding: auto`` (None: the
+        thesis's convention). With ``settle`` false the friction ratio is kept
+        from ``previous`` (an integrator's trial evaluations within a step);
+        with ``detail`` false the finger's shape and the penetration check are
+        skipped (force, point and angles only).
+        Returns the solution and the state to continue from at the next time
+        or pose.
+        """
         self.newton_iterations = 0
         length = self.finger.length
-        ell = pose.view(ellipse_w)
         if ell.level(0.0, 0.0) <= 0.0:
             return no_contact(pose, length, "the finger base is inside the object: invalid pose",
                               converged=False), None
         if segment_overlap(ell, length) >= 0.0:
             return no_contact(pose, length, "the straight finger misses the object"), None
-        side = self._side(ell, pose, ellipse_w, sliding, motion, previous)
-        tau_mu = self._initial_tau_mu(sliding, previous, ell, side, pose, ellipse_w, motion)
+        side = self._side(ell, sliding, kinematics, previous)
+        tau_mu = self._initial_tau_mu(sliding, previous, kinematics)
         if previous is not None and previous.side == side:
             state, msg = self._continue(previous, ell, tau_mu)
             if state is None and msg != BASE_REACHED:
@@ -181,38 +211,32 @@ class RobustContact:
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
         friction, v_slide = self._friction_label(tau_mu), None
-        if sliding == "auto" and motion is not None and self.mu > 0:
-            state, friction, msg2, v_slide = self._settle_friction(state, pose, ellipse_w, motion)
+        if sliding == "auto" and kinematics is not None and self.mu > 0 and settle:
+            state, friction, msg2, v_slide = self._settle_friction(state, kinematics)
             msg = "; ".join(m for m in (msg, msg2) if m)
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
-        sol = self._solution(state, pose, friction, msg)
+        sol = self._solution(state, pose, friction, msg) if detail else \
+            self._brief(state, pose, friction, msg)
         sol.extras["sliding_velocity"] = v_slide
         return sol, state
 
-    def _side(self, ell, pose, ellipse_w, sliding, motion, previous) -> int:
+    def _side(self, ell, sliding, kinematics, previous) -> int:
         """+1 (push: finger deflected to +y_f) or -1 (pull)."""
         if sliding in SIDES:
             return SIDES[sliding]
         if previous is not None:
             return previous.side
-        if motion is not None:
-            # the object meets the finger from the side it approaches from
-            up, down = grazing(ell, self.finger.length, +1), grazing(ell, self.finger.length, -1)
-            x_g = (up or down)[1]
-            p_w = pose.to_world(x_g, 0.0)[:, 0]
-            v_rel = _object_velocity(p_w, ellipse_w, motion) - _rigid_velocity(p_w, motion)
-            v_y = float(rotation(pose.angle).T @ v_rel @ np.array([0.0, 1.0]))
-            if abs(v_y) > 1e-12:
-                return 1 if v_y > 0 else -1
-        # otherwise: the side the finger has to bend less to clear the object
+        # the side the finger has to bend less to clear the object: at first
+        # touch (a pass, a time step) the overlap is small on that side only;
+        # a single pose with a motion is played back to first touch (solve)
         up, down = grazing(ell, self.finger.length, +1), grazing(ell, self.finger.length, -1)
         return 1 if up[0] <= down[0] else -1
 
-    def _initial_tau_mu(self, sliding, previous, ell, side, pose, ellipse_w, motion) -> float:
+    def _initial_tau_mu(self, sliding, previous, kinematics) -> float:
         if self.mu == 0.0:
             return 0.0
-        if sliding in SIDES or motion is None:
+        if sliding in SIDES:
             return self.mu          # the thesis's convention: friction on the finger tipwards
         if previous is not None:
             return previous.tau_mu
@@ -248,17 +272,17 @@ class RobustContact:
     def _continue(self, state: _State, target: Ellipse, tau_mu: float):
         """Continue ``state`` to the target ellipse and friction, in adaptive steps."""
         src = state.ellipse
-        p0 = np.array([src.center[0], src.center[1], src.theta, state.tau_mu])
+        p0 = np.array([src.center[0], src.center[1], src.theta, src.a, src.b, state.tau_mu])
         p1 = np.array([target.center[0], target.center[1],
-                       src.theta + _wrap(target.theta - src.theta), tau_mu])
+                       src.theta + _wrap(target.theta - src.theta), target.a, target.b, tau_mu])
         t, step = 0.0, 1.0
         for _ in range(self.max_steps):
             if t >= 1.0:
                 return state, ""
             t_new = min(1.0, t + step)
             p = p0 + t_new * (p1 - p0)
-            ell = Ellipse(target.a, target.b, (p[0], p[1]), p[2])
-            new = self._step(state, ell, p[3])
+            ell = Ellipse(p[3], p[4], (p[0], p[1]), p[2])
+            new = self._step(state, ell, p[5])
             if new is None:
                 step /= 2
                 if step < 1e-7:
@@ -289,7 +313,7 @@ class RobustContact:
                 return None
             verdict = self._check(mode, post)
             if verdict == "ok":
-                return _State(mode, z_new, ell, tau_mu, state.side)
+                return _State(mode, z_new, ell, tau_mu, state.side, post)
             if verdict in ("release", "base"):
                 return verdict
             if verdict == "tip":
@@ -302,7 +326,7 @@ class RobustContact:
         tr = self.tr[mode]
         q = tr.parameters(self.finger.length, self.ei_ref, ell, tau_mu, self.widths,
                           self.finger.stiffness)
-        rf = tr.rootfinder(self.tolerance)
+        rf = tr.rootfinder(self.tolerance, MAX_NEWTON_ITERATIONS)
         z = np.asarray(rf(z0, q)).ravel()
         self._last_iterations = int(rf.stats().get("iter_count", 0))
         self.newton_iterations += self._last_iterations
@@ -329,7 +353,7 @@ class RobustContact:
         return "ok" if along <= 0 else "interior"
 
     # ------------------------------------------------------------ friction
-    def _settle_friction(self, state, pose, ellipse_w, motion):
+    def _settle_friction(self, state, kin):
         """Friction ratio m = τµ consistent with the sliding velocity v(m).
 
         Physical states: sliding tipwards with the friction on the finger
@@ -339,7 +363,14 @@ class RobustContact:
         the bound (sliding the other way): the friction force is continued,
         never flipped past a sticking state.
         """
-        v = self._sliding_velocity(state, pose, ellipse_w, motion)
+        v = self._sliding_velocity(state, kin)
+        if self.reversal_speed is not None:
+            if v * state.tau_mu <= self.reversal_speed * self.mu:   # not clearly reversed
+                return state, self._friction_label(state.tau_mu), "", v
+            moved, msg = self._continue(state, state.ellipse, -state.tau_mu)
+            if moved is None:
+                return state, self._friction_label(state.tau_mu), f"friction kept: {msg}", v
+            return moved, self._friction_label(moved.tau_mu), "", v
         if self._consistent(state.tau_mu, v):
             return state, self._friction_label(state.tau_mu), "", v
         target = -self.mu if v > 0 else self.mu
@@ -350,7 +381,7 @@ class RobustContact:
             end, msg2 = self._from_grazing(state.ellipse, state.side, target)
             if end is None:
                 return None, "none", f"no equilibrium with friction ratio {target:+g}: {msg}", None
-        v_end = self._sliding_velocity(end, pose, ellipse_w, motion)
+        v_end = self._sliding_velocity(end, kin)
         if v_end * v > 0 or v_end == 0.0:          # still sliding the same way: at the bound
             return end, self._friction_label(end.tau_mu), "", v_end
         a, b, v_a = state, end, v                   # v changes sign in between: stick
@@ -358,7 +389,7 @@ class RobustContact:
             mid, msg = self._continue(a, a.ellipse, 0.5 * (a.tau_mu + b.tau_mu))
             if mid is None:
                 break
-            v_mid = self._sliding_velocity(mid, pose, ellipse_w, motion)
+            v_mid = self._sliding_velocity(mid, kin)
             if v_mid * v_a > 0:
                 a, v_a = mid, v_mid
             else:
@@ -375,32 +406,28 @@ class RobustContact:
             return v >= 0
         return abs(v) <= STICK_SPEED
 
-    def _sliding_velocity(self, state: _State, pose: FingerPose, ellipse_w: Ellipse,
-                          motion: Motion) -> float:
+    def _sliding_velocity(self, state: _State, kin: "Kinematics") -> float:
         """Finger material point's velocity relative to the object's surface,
-        along the sliding tangent (m/s, + towards the finger tip)."""
+        along the sliding tangent (m/s, + towards the finger tip).
+
+        The finger's material point at the contact moves in its own frame by
+        d(x_L, y_L)/dt - t_f dL/dt, the rates following from the contact
+        equations by the implicit-function theorem with the ellipse's
+        parameter rates; the object's point moves relative to the frame as
+        ``kin`` says.
+        """
         tr = self.tr[state.mode]
         q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
                           self.widths, self.finger.stiffness)
         jz, jq, jtip = (np.asarray(m) for m in tr.sensitivity(state.z, q))
         post, _ = (np.asarray(v).ravel() for v in tr.post(state.z, q))
-        # rate of the ellipse parameters in the finger frame (cx, cy, θ)
-        omega = motion.drum_speed
-        c_w = np.asarray(ellipse_w.center, float)
-        rot_t = rotation(pose.angle).T
-        J = np.array([[0.0, -1.0], [1.0, 0.0]])
-        c_dot = omega * J @ rot_t @ c_w + rot_t @ np.asarray(motion.object_velocity, float)
-        q_dot = np.array([c_dot[0], c_dot[1], motion.object_spin + omega])
+        point = post[:2]
+        q_dot, v_object = kin(point)
         z_dot = np.linalg.lstsq(jz, -jq @ q_dot, rcond=None)[0]
         x_dot, y_dot, l_dot = jtip @ z_dot
-        psi = post[2]
-        t_f = np.array([np.cos(psi), np.sin(psi)])
-        v_material_f = np.array([x_dot, y_dot]) - t_f * l_dot
-        p_w = pose.to_world(post[0], post[1])[:, 0]
-        v_finger = _rigid_velocity(p_w, motion) + rotation(pose.angle) @ v_material_f
-        v_rel = v_finger - _object_velocity(p_w, ellipse_w, motion)
-        t_c = rotation(pose.angle) @ post[9:11]
-        return float(v_rel @ t_c)
+        t_f = np.array([np.cos(post[2]), np.sin(post[2])])
+        v_material = np.array([x_dot, y_dot]) - t_f * l_dot
+        return float((v_material - v_object) @ post[9:11])
 
     def _friction_label(self, tau_mu: float) -> str:
         if self.mu == 0.0 or tau_mu == 0.0:
@@ -437,16 +464,43 @@ class RobustContact:
                     "mode": state.mode, "base_moment": float(moment[0])})
 
 
+    def _brief(self, state: _State, pose: FingerPose, friction: str, msg: str
+               ) -> ContactSolution:
+        """The contact without the finger's shape (for trial evaluations)."""
+        x_l, y_l, psi_l, force, alpha, arc = state.post[:6]
+        s = np.array([0.0, arc])
+        return ContactSolution(
+            True, float(force), float(alpha), float(arc), (float(x_l), float(y_l)),
+            float(psi_l), state.mode == "tip", "push" if state.side > 0 else "pull", friction,
+            pose, s, np.array([0.0, x_l]), np.array([0.0, y_l]), True, self.newton_iterations,
+            msg, extras={"friction_ratio": state.tau_mu, "mode": state.mode})
+
+
 def _wrap(angle: float) -> float:
     return float((angle + np.pi) % (2 * np.pi) - np.pi)
 
 
-def _rigid_velocity(p_w: np.ndarray, motion: Motion) -> np.ndarray:
-    """Velocity of a point carried by the drum (clockwise for ω > 0), m/s."""
-    return motion.drum_speed * np.array([p_w[1], -p_w[0]])
+#: kinematics(p_f) -> (rates of (cx, cy, θ, a, b) in the finger frame, the
+#: object's material velocity at p_f relative to the finger frame), m/s
+Kinematics = Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]
 
 
-def _object_velocity(p_w: np.ndarray, ellipse_w: Ellipse, motion: Motion) -> np.ndarray:
-    """Velocity of the object's material point at p_w, m/s."""
-    r = p_w - np.asarray(ellipse_w.center, float)
-    return np.asarray(motion.object_velocity, float) + motion.object_spin * np.array([-r[1], r[0]])
+def planar_kinematics(pose: FingerPose, ellipse_w: Ellipse, motion: Motion) -> Kinematics:
+    """Rates seen from a finger on a drum turning at ω (clockwise for ω > 0)
+    with the object translating and spinning in the plane."""
+    omega = motion.drum_speed
+    rot = rotation(pose.angle)
+    c_w = np.asarray(ellipse_w.center, float)
+    v_obj = np.asarray(motion.object_velocity, float)
+    J = np.array([[0.0, -1.0], [1.0, 0.0]])
+    c_dot = omega * J @ rot.T @ c_w + rot.T @ v_obj
+    q_dot = np.array([c_dot[0], c_dot[1], motion.object_spin + omega, 0.0, 0.0])
+
+    def kin(p_f: np.ndarray):
+        p_w = pose.to_world(p_f[0], p_f[1])[:, 0]
+        frame_v = omega * np.array([p_w[1], -p_w[0]])        # the drum carries the frame
+        r = p_w - c_w
+        object_v = v_obj + motion.object_spin * np.array([-r[1], r[0]])
+        return q_dot, rot.T @ (object_v - frame_v)
+
+    return kin

@@ -1,0 +1,177 @@
+"""The grasper in 3-D: drums, finger frames, and the bird's ellipsoid cut by a
+finger's bending plane (thesis ch. IV, appendix B; MODEL.md §4).
+
+World frame Cw: origin on the conveyor surface midway between the two drum
+axes, X along the conveyor's motion, Z up, Y towards the left drum. The
+*right* drum's axis passes through (X_d, -d/2, 0); the left drum is its
+mirror image about the XZ plane and turns the other way.
+
+A finger on the right drum at angle φ (rad, about the drum axis, measured
+from +X towards +Y, i.e. towards the bird) has its base at radius r_D and
+height h along the axis. Its frame Cf3 is built by active rotations
+
+    R = R_tilt · R_z(φ) · R_y(φ_y) · R_x(φ_x)
+
+where R_tilt tilts the drum axis from vertical about the world Y axis. The
+columns of R are the finger's x (the undeformed finger), y (the direction it
+bends in) and z (the direction it is rigid in). With φ_x = φ_y = 0 the finger
+is radial and horizontal and bends in the horizontal plane, as in ch. III;
+φ_y > 0 tilts it downwards (tip below base), φ_x = 90° turns its bending
+plane vertical.
+
+The thesis's Table 5-1 does not fix its angle origin or senses in the
+extracted text. Read as the mirror-image drum, φ = -φ_i - 37.5°,
+φ_x = -φ_x(thesis), φ_y as printed, its
+lower fingers (φ_y = +15°) slide under the bird's belly and the upper ones
+(φ_y = -15°) pass over its back, the middle lower finger faces the bird as
+its centre crosses the drum axis (Table 5-3's timing), and the simulation
+shows what the thesis describes (hard lower fingers hold longer; peak force
+at fingers 3-4 of 14-19 N against "about 11 N"). The other readings tried
+(the other signs of φ_x and φ_y, phases ±20°) flip the bird or press it
+down; see models/graspers/thesis_table_5_1.yaml.
+
+The right drum turns clockwise seen from above, φ(t) = φ_i - ω t: on the bird's
+side its fingers move downstream with the conveyor.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from design.physics.ellipse import Ellipse
+
+MIRROR = np.diag([1.0, -1.0, 1.0])
+
+
+def rot_x(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+
+
+def rot_y(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def rot_z(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+@dataclass(frozen=True)
+class FingerMount:
+    """Where and how a finger sits on a drum (right drum; the left mirrors it).
+
+    ``angle`` φ_i (rad) at t = 0, ``height`` h (m) along the drum axis,
+    ``radius`` r_D (m) of the drum at that height, mounting rotations
+    ``phi_x`` and ``phi_y`` (rad).
+    """
+
+    angle: float
+    height: float
+    radius: float
+    phi_x: float = 0.0
+    phi_y: float = 0.0
+
+
+@dataclass(frozen=True)
+class Drum:
+    """The right drum: axis through (x, -spacing/2, 0), tilted by ``tilt``
+    (rad, about world Y, from vertical), turning at ``speed`` ω (rad/s)."""
+
+    spacing: float
+    speed: float
+    x: float = 0.0
+    tilt: float = 0.0
+
+    @property
+    def origin(self) -> np.ndarray:
+        return np.array([self.x, -self.spacing / 2, 0.0])
+
+    def frame(self, mount: FingerMount, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Base point (3,) and rotation (3, 3) of a finger at time t (right drum)."""
+        phi = mount.angle - self.speed * t
+        r_tilt = rot_y(self.tilt)
+        base = self.origin + r_tilt @ np.array([mount.radius * np.cos(phi),
+                                                mount.radius * np.sin(phi), mount.height])
+        R = r_tilt @ rot_z(phi) @ rot_y(mount.phi_y) @ rot_x(mount.phi_x)
+        return base, R
+
+
+def mirror_frame(base: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The left drum's finger: the right one reflected about the XZ plane.
+
+    A reflection is not a rotation; the bending axis (y) is reflected too and
+    z is flipped so the frame stays right-handed: the left finger bends to
+    the mirror image of where the right one bends.
+    """
+    Rm = MIRROR @ R
+    Rm[:, 2] *= -1.0
+    return MIRROR @ base, Rm
+
+
+@dataclass(frozen=True)
+class Ellipsoid:
+    """The bird: semi-axes η (length, body x), λ (width, y), γ (height, z)
+    in m, centre (3,) in m, pitch θ (rad) about the world Y axis."""
+
+    eta: float
+    lam: float
+    gamma: float
+    center: tuple[float, float, float]
+    pitch: float = 0.0
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """Body to world. Pitch convention X = x cos θ + z sin θ (MODEL.md §5):
+        a positive θ turns the body's nose (+x) downwards."""
+        return rot_y(self.pitch)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        return np.diag([1 / self.eta ** 2, 1 / self.lam ** 2, 1 / self.gamma ** 2])
+
+    def level(self, points: np.ndarray) -> np.ndarray:
+        """< 0 inside, 0 on the surface; points shape (3, ...)."""
+        p = np.einsum("ji,j...->i...", self.rotation,
+                      points - np.asarray(self.center).reshape(3, *([1] * (points.ndim - 1))))
+        return np.einsum("i...,ii,i...->...", p, self.matrix, p) - 1.0
+
+    def cut(self, base: np.ndarray, R: np.ndarray) -> Ellipse | None:
+        """The ellipse in which the plane z_f = 0 of a finger frame cuts the
+        ellipsoid, in that frame's (x_f, y_f) coordinates; None if it misses.
+
+        Points u = (x_f, y_f) of the plane are p_b = d + M u in body
+        coordinates, d = R_b^T (base - c), M = R_b^T R[:, :2]; the quadric
+        p_b^T B p_b = 1 becomes u^T A u + 2 b^T u + c0 = 1 with A = M^T B M.
+        """
+        Rb = self.rotation
+        d = Rb.T @ (np.asarray(base, float) - np.asarray(self.center, float))
+        M = Rb.T @ R[:, :2]
+        B = self.matrix
+        A = M.T @ B @ M
+        b = M.T @ B @ d
+        c0 = float(d @ B @ d)
+        u0 = -np.linalg.solve(A, b)
+        rhs = 1.0 - (c0 + float(b @ u0))
+        if rhs <= 0.0:
+            return None
+        vals, vecs = np.linalg.eigh(A / rhs)
+        axes = 1.0 / np.sqrt(vals)
+        theta = float(np.arctan2(vecs[1, 0], vecs[0, 0]))
+        return Ellipse(float(axes[0]), float(axes[1]), (float(u0[0]), float(u0[1])), theta)
+
+    def lowest_point(self) -> tuple[float, float]:
+        """(X offset ahead of the centre, depth D below it) of the lowest point
+        of the pitched ellipsoid's XZ section (MODEL.md §5; thesis 4.33-4.35)."""
+        return lowest_point(self.eta, self.gamma, self.pitch)
+
+
+def lowest_point(eta: float, gamma: float, pitch: float) -> tuple[float, float]:
+    """Offset ahead of the centre and depth D = sqrt(γ² cos²θ + η² sin²θ) of
+    the lowest point of an ellipse (η along x, γ along z) pitched by θ."""
+    c, s = np.cos(pitch), np.sin(pitch)
+    D = np.sqrt(gamma ** 2 * c ** 2 + eta ** 2 * s ** 2)
+    return (eta ** 2 - gamma ** 2) * s * c / D, D

@@ -1,0 +1,345 @@
+"""Integrating the grasp: an event-driven adaptive integrator (default) and the
+thesis's fixed-step BDF-4 with frozen forces (baseline).
+
+Adaptive (``adaptive``): explicit Runge-Kutta with error control (scipy's
+DOP853 or RK45 stepper), one smooth ODE per conveyor mode (air, slip,
+stick). Mode switches are events located on the step's dense output by a
+root finder: lift-off (N = 0), touch-down (the lowest point reaches the
+belt, plastic impact), stick/slip of the lowest point on the belt, and the
+start and end of the conveyor's deceleration. Finger contacts are evaluated
+at every stage; their friction direction is decided at accepted steps (the
+stepper restarts when one changes).
+
+BDF-4 (``bdf4``, thesis §4.4): fixed step h, forces frozen over the step,
+conveyor friction sign updated at the end of the step, the conveyor contact
+dropped when N < 0 and restored when the body reaches the belt.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import DOP853, RK45
+from scipy.optimize import brentq
+
+from design.physics.bird import BirdDynamics, Conveyor, Loads
+from design.solve.grasp.fingers import FingerForces, FingerState
+
+STEPPERS = {"dop853": DOP853, "rk45": RK45}
+INTEGRATORS = ("adaptive", "bdf4")
+
+
+@dataclass(frozen=True)
+class IntegratorSettings:
+    """How to integrate: ``adaptive`` (rtol, atol in m, max_step s, stepper) or
+    ``bdf4`` (step h in s)."""
+
+    integrator: str = "adaptive"
+    rtol: float = 1e-6
+    atol: float = 1e-8
+    max_step: float = 2e-3
+    stepper: str = "rk45"
+    step: float = 5.6e-3
+
+    def finer(self, factor: float = 4.0) -> "IntegratorSettings":
+        """Settings at ``factor`` times finer resolution (a reference run)."""
+        return IntegratorSettings(self.integrator, self.rtol / factor ** 4, self.atol / factor ** 4,
+                                  self.max_step / factor, self.stepper, self.step / factor)
+
+
+@dataclass
+class Record:
+    """One instant of the run."""
+
+    t: float
+    y: np.ndarray
+    mode: str
+    normal: float
+    friction: float
+    belt_speed: float
+    fingers: list[FingerState]
+
+
+@dataclass
+class Trajectory:
+    records: list[Record] = field(default_factory=list)
+    events: list[tuple[float, str]] = field(default_factory=list)
+    steps: int = 0
+    rejected: int = 0
+    wall_time: float = 0.0
+    message: str = ""
+    ok: bool = True
+
+
+class Grasp:
+    """The bird, the conveyor and the fingers: the hybrid system to integrate."""
+
+    def __init__(self, dynamics: BirdDynamics, conveyor: Conveyor, fingers: FingerForces):
+        self.dyn, self.conveyor, self.fingers = dynamics, conveyor, fingers
+        self.start: float | None = conveyor.start_time if conveyor.decelerates else None
+
+    def belt(self, t: float) -> tuple[float, float]:
+        return self.conveyor.velocity(t, self.start)
+
+    def solve_mode(self, t, y, mode, slip_sign, loads):
+        v, v_dot = self.belt(t)
+        acc, normal, friction = self.dyn.accelerations(y, loads, mode, v_dot, slip_sign)
+        return acc, normal, friction
+
+    def rhs(self, t, y, mode, slip_sign):
+        loads, _ = self.fingers.evaluate(t, y)
+        acc, _, _ = self.solve_mode(t, y, mode, slip_sign, loads)
+        return np.concatenate([y[3:], acc])
+
+    def record(self, t, y, mode, slip_sign, commit=True) -> Record:
+        loads, states = self.fingers.evaluate(t, y, commit=commit)
+        _, normal, friction = self.solve_mode(t, y, mode, slip_sign, loads)
+        return Record(t, y.copy(), mode, normal, friction, self.belt(t)[0], states)
+
+    def initial_mode(self, y) -> str:
+        return "stick"
+
+
+def integrate(grasp: Grasp, y0: np.ndarray, t_end: float, settings: IntegratorSettings,
+              progress=None) -> Trajectory:
+    run = {"adaptive": _adaptive, "bdf4": _bdf4}[settings.integrator]
+    t0 = time.perf_counter()
+    traj = run(grasp, y0, t_end, settings, progress)
+    traj.wall_time = time.perf_counter() - t0
+    return traj
+
+
+# ------------------------------------------------------------------ adaptive
+#: the lowest point counts as on the belt within this height (m)
+GAP_TOL = 1e-9
+#: slip speeds (m/s) below this count as rolling with the belt
+SLIP_TOL = 1e-9
+#: an event fires only after its function exceeded this since the last switch
+#: (N in newtons, slip in m/s, gap in m, times in s)
+EVENT_ARM = {"lift-off": 1e-9, "slip": 1e-9, "stick": 1e-9, "touch-down": 0.0,
+             "belt slows": 0.0, "belt steady": 0.0}
+#: this many events within a nanosecond is chattering: the run stops and says so
+MAX_EVENTS_AT_ONCE = 20
+
+
+def decide_mode(grasp: Grasp, t: float, y: np.ndarray, landing: bool = False):
+    """(mode, slip sign, state) consistent with (t, y).
+
+    Off the belt: air. On it: air again if the free motion would lift the
+    lowest point anyway; else stick if A rolls with the belt and the friction
+    it needs is inside the cone, else slip in the direction A moves (or, from
+    rest, the direction the friction cannot hold). If sliding would need a
+    negative normal force (friction's Painlevé paradox), the belt holds A.
+    """
+    dyn = grasp.dyn
+    if dyn.gap(y) > GAP_TOL and not landing:
+        return "air", 0.0, y
+    y = dyn.land(y) if landing else dyn.settle(y)
+    loads, _ = grasp.fingers.evaluate(t, y)
+    free, _, _ = grasp.solve_mode(t, y, "air", 0.0, loads)
+    _, _, d1, d2 = dyn.support(y[2])
+    if free[1] - d1 * free[2] - d2 * y[5] ** 2 > 0:
+        return "air", 0.0, y
+    _, normal, friction = grasp.solve_mode(t, y, "stick", 0.0, loads)
+    s = dyn.slip(y, grasp.belt(t)[0])
+    if normal > 0 and abs(s) <= SLIP_TOL and abs(friction) < dyn.mu * normal * (1 - 1e-9):
+        return "stick", 0.0, y
+    sign = float(np.sign(s)) if abs(s) > SLIP_TOL else -float(np.sign(friction)) or 1.0
+    if grasp.solve_mode(t, y, "slip", sign, loads)[1] > 0:
+        return "slip", sign, y
+    return "stick", 0.0, y
+
+
+def _events(grasp: Grasp, mode: str, slip_sign: float):
+    """Event functions g(t, y) of a mode: a sign change from + to - is the event."""
+    dyn = grasp.dyn
+    ev = {}
+    if mode in ("slip", "stick"):
+        def lift(t, y):
+            loads, _ = grasp.fingers.evaluate(t, y)
+            return grasp.solve_mode(t, y, mode, slip_sign, loads)[1]
+        ev["lift-off"] = lift
+    if mode == "stick":
+        def breakaway(t, y):
+            loads, _ = grasp.fingers.evaluate(t, y)
+            _, normal, friction = grasp.solve_mode(t, y, mode, slip_sign, loads)
+            return dyn.mu * normal - abs(friction)
+        ev["slip"] = breakaway
+    if mode == "slip":
+        ev["stick"] = lambda t, y: slip_sign * dyn.slip(y, grasp.belt(t)[0])
+    if mode == "air":
+        ev["touch-down"] = lambda t, y: dyn.gap(y) + GAP_TOL
+    conv = grasp.conveyor
+    if conv.decelerates and grasp.start is None and conv.start_position is not None:
+        ev["belt slows"] = lambda t, y: conv.start_position - y[0]
+    if grasp.start is not None and conv.decelerates:
+        t_ramp = grasp.start + (conv.speed - conv.final_speed) / conv.rate
+        ev["belt steady"] = lambda t, y: t_ramp - t
+    return ev
+
+
+def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, slip_sign: float):
+    """New (mode, slip sign, state) after an event."""
+    if name == "belt slows":
+        grasp.start = t
+    if name in ("belt slows", "belt steady"):
+        return mode, slip_sign, y
+    if name == "lift-off":
+        return "air", 0.0, y
+    if name == "slip":                        # the friction reached the cone: slip begins
+        loads, _ = grasp.fingers.evaluate(t, y)
+        _, _, friction = grasp.solve_mode(t, y, "stick", 0.0, loads)
+        return "slip", -float(np.sign(friction)) or 1.0, y
+    return decide_mode(grasp, t, y, landing=name == "touch-down")
+
+
+def _locate(f, dense, t_old: float, t_new: float) -> float:
+    """Where g(t) = f(t, dense(t)) crosses zero in [t_old, t_new].
+
+    Finger forces are continued from the latest solution, so g at the
+    dense-output points may differ from the step's end values by the Newton
+    tolerance: an end that has already crossed puts the event there.
+    """
+    g = lambda tt: f(tt, dense(tt))  # noqa: E731
+    g_lo, g_hi = g(t_old), g(t_new)
+    if g_lo <= 0:
+        return t_old
+    if g_hi > 0:
+        return t_new
+    return brentq(g, t_old, t_new, xtol=1e-12)
+
+
+def _adaptive(grasp: Grasp, y0, t_end, s: IntegratorSettings, progress) -> Trajectory:
+    traj = Trajectory()
+    t = 0.0
+    mode, slip_sign, y = decide_mode(grasp, t, np.asarray(y0, float))
+    traj.records.append(grasp.record(t, y, mode, slip_sign))
+    last_report = 0.0
+    while t < t_end - 1e-12:
+        fun = (lambda m, sg: (lambda tt, yy: grasp.rhs(tt, yy, m, sg)))(mode, slip_sign)
+        stepper = STEPPERS[s.stepper](fun, t, y, t_end, rtol=s.rtol, atol=s.atol,
+                                      max_step=s.max_step)
+        events = _events(grasp, mode, slip_sign)
+        restart = False
+        while not restart and stepper.status == "running":
+            t_old, y_old = stepper.t, stepper.y.copy()
+            g_old = {k: f(t_old, y_old) for k, f in events.items()}
+            msg = stepper.step()
+            if stepper.status == "failed":
+                traj.ok, traj.message = False, f"integrator failed at t = {t_old:.4f} s: {msg}"
+                return traj
+            traj.steps += 1
+            dense = stepper.dense_output()
+            t_new, y_new = stepper.t, stepper.y.copy()
+            hits = []
+            for name, f in events.items():
+                # armed only once clearly positive: a switch leaves its new mode's
+                # event functions at zero, and rounding must not switch back
+                if g_old[name] > EVENT_ARM[name] and f(t_new, y_new) <= 0:
+                    hits.append((_locate(f, dense, t_old, t_new), name))
+            if hits:
+                tau, name = min(hits)
+                if len(traj.events) >= MAX_EVENTS_AT_ONCE and \
+                        tau - traj.events[-MAX_EVENTS_AT_ONCE][0] < 1e-9:
+                    traj.ok = False
+                    traj.message = (f"modes chatter at t = {tau:.6f} s: "
+                                    f"{', '.join(e[1] for e in traj.events[-5:])}")
+                    return traj
+                traj.events.append((float(tau), name))
+                mode, slip_sign, y = _after_event(grasp, name, tau, dense(tau), mode, slip_sign)
+                t = tau
+                traj.records.append(grasp.record(t, y, mode, slip_sign))
+                restart = True
+                continue
+            before = [None if st is None else st.tau_mu for st in grasp.fingers.states]
+            traj.records.append(grasp.record(t_new, y_new, mode, slip_sign))
+            after = [None if st is None else st.tau_mu for st in grasp.fingers.states]
+            t, y = t_new, y_new
+            if any(a is not None and b is not None and a != b for a, b in zip(before, after)):
+                # a finger's friction turned: a new smooth piece, and the belt
+                # contact must be decided again under the new forces
+                restart = True
+                if mode != "air":
+                    mode, slip_sign, y = decide_mode(grasp, t, y)
+            if progress and t - last_report >= 0.1:
+                progress(f"grasp: t = {t:.2f} s of {t_end:g} s, mode {mode}, "
+                         f"{traj.steps} steps")
+                last_report = t
+    return traj
+
+
+# ---------------------------------------------------------------------- BDF-4
+_BDF = {1: ([1.0], 1.0), 2: ([4 / 3, -1 / 3], 2 / 3), 3: ([18 / 11, -9 / 11, 2 / 11], 6 / 11),
+        4: ([48 / 25, -36 / 25, 16 / 25, -3 / 25], 12 / 25)}
+
+
+def _bdf4(grasp: Grasp, y0, t_end, s: IntegratorSettings, progress) -> Trajectory:
+    """Thesis §4.4: BDF of order 4 (lower orders to start), forces frozen."""
+    traj = Trajectory()
+    dyn, h = grasp.dyn, s.step
+    y = dyn.settle(np.asarray(y0, float))
+    t = 0.0
+    mode = "slip"
+    history = [y.copy()]
+    n_steps = int(np.ceil(t_end / h - 1e-9))
+    rec = grasp.record(t, y, mode, 0.0)
+    traj.records.append(rec)
+    for n in range(n_steps):
+        loads, _ = grasp.fingers.evaluate(t, y)            # frozen over the step
+        v, v_dot = grasp.belt(t)
+        sign = float(np.sign(dyn.slip(y, v)))               # frozen friction sign
+        if grasp.conveyor.decelerates and grasp.start is None and \
+                grasp.conveyor.start_position is not None and y[0] >= grasp.conveyor.start_position:
+            grasp.start = t
+        order = min(len(history), 4)
+        alphas, beta = _BDF[order]
+        known = sum(a * history[-1 - j] for j, a in enumerate(alphas))
+
+        def residual(z):
+            acc, _, _ = dyn.accelerations(z, loads, mode, v_dot, sign)
+            return z - known - h * beta * np.concatenate([z[3:], acc])
+
+        z = _newton(residual, history[-1])
+        t += h
+        if mode != "air":
+            _, normal, _ = dyn.accelerations(z, loads, mode, v_dot, sign)
+            if normal < 0:
+                mode = "air"
+                traj.events.append((t, "lift-off"))
+            else:
+                z = dyn.settle(z)
+        elif dyn.gap(z) < 0:
+            z = dyn.land(z)
+            mode = "slip"
+            traj.events.append((t, "touch-down"))
+        y = z
+        history.append(y.copy())
+        history = history[-4:]
+        traj.steps += 1
+        rec = grasp.record(t, y, mode, sign)
+        traj.records.append(rec)
+        if progress and n % 50 == 0:
+            progress(f"grasp (BDF-4): t = {t:.2f} s of {t_end:g} s")
+    return traj
+
+
+def _newton(residual, z0, tol=1e-12, max_iter=20):
+    """Newton with a forward-difference Jacobian (6 unknowns)."""
+    z = z0.copy()
+    for _ in range(max_iter):
+        r = residual(z)
+        J = np.empty((z.size, z.size))
+        for j in range(z.size):
+            dz = np.zeros_like(z)
+            dz[j] = 1e-7 * max(1.0, abs(z[j]))
+            J[:, j] = (residual(z + dz) - r) / dz[j]
+        step = np.linalg.solve(J, -r)
+        z = z + step
+        if np.max(np.abs(step)) < tol:
+            break
+    return z
+
+
+__all__ = ["Grasp", "IntegratorSettings", "Trajectory", "integrate", "INTEGRATORS", "Loads"]

@@ -1,0 +1,121 @@
+"""One grasp simulation: set up, integrate, summarise (solver level, no I/O)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from design.physics.bird import Bird, BirdDynamics, Conveyor, Legs
+from design.physics.grasper import Grasper
+from design.solve.grasp.fingers import FingerForces, reach_windows
+from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, integrate
+
+
+@dataclass(frozen=True)
+class GraspSetup:
+    """The physical system and its start (SI)."""
+
+    grasper: Grasper
+    bird: Bird
+    conveyor: Conveyor
+    drum_speed: float
+    start_x: float
+    finger_friction: float
+    conveyor_friction: float
+    legs: Legs
+    duration: float
+
+
+@dataclass
+class GraspRun:
+    setup: GraspSetup
+    trajectory: Trajectory
+    windows: list | None
+    contact_solves: int
+    skipped: int
+    setup_time: float
+
+    @property
+    def summary(self) -> dict:
+        return summarise(self)
+
+
+def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = IntegratorSettings(),
+                   contact_nodes: int = 6, reach_filter: bool = True, progress=None) -> GraspRun:
+    """Integrate the symmetric grasp from the bird sitting on the belt at start_x."""
+    t0 = time.perf_counter()
+    b, conv = setup.bird, setup.conveyor
+    windows = None
+    if reach_filter:
+        # the belt carries the bird: its centre follows X0 + v t within the margin
+        path = lambda t: (setup.start_x + conv.speed * t, b.gamma)  # noqa: E731
+        if conv.decelerates:
+            path = lambda t: (setup.start_x + conv.final_speed * t, b.gamma)  # noqa: E731
+            windows_fast = reach_windows(setup.grasper, b, setup.drum_speed,
+                                         lambda t: (setup.start_x + conv.speed * t, b.gamma),
+                                         setup.duration)
+        windows = reach_windows(setup.grasper, b, setup.drum_speed, path, setup.duration)
+        if conv.decelerates:                       # a band covering both belt speeds
+            windows = [_union(w1, w2) for w1, w2 in zip(windows, windows_fast)]
+    fingers = FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction, windows,
+                           intervals=contact_nodes)
+    dyn = BirdDynamics(b, setup.legs, setup.conveyor_friction)
+    grasp = Grasp(dyn, conv, fingers)
+    y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])
+    setup_time = time.perf_counter() - t0
+    traj = integrate(grasp, y0, setup.duration, integrator, progress)
+    return GraspRun(setup, traj, windows, fingers.solves, fingers.skipped, setup_time)
+
+
+def _union(a, b):
+    spans = sorted(a + b)
+    out = []
+    for lo, hi in spans:
+        if out and lo <= out[-1][1]:
+            out[-1] = (out[-1][0], max(out[-1][1], hi))
+        else:
+            out.append((lo, hi))
+    return out
+
+
+def hold_windows(run: GraspRun) -> list[tuple[float, float]]:
+    """Intervals (s) in which the belt does not support the bird (N = 0)."""
+    recs = run.trajectory.records
+    out, start = [], None
+    for r in recs:
+        if r.mode == "air" and start is None:
+            start = r.t
+        elif r.mode != "air" and start is not None:
+            out.append((start, r.t))
+            start = None
+    if start is not None:
+        out.append((start, recs[-1].t))
+    return out
+
+
+def summarise(run: GraspRun) -> dict:
+    recs = run.trajectory.records
+    windows = hold_windows(run)
+    names = [gf.name for gf in run.setup.grasper.fingers]
+    force = np.array([[f.magnitude for f in r.fingers] for r in recs])
+    k, j = np.unravel_index(np.argmax(force), force.shape)
+    z = np.array([r.y[1] for r in recs])
+    gap = z - np.array([BirdDynamics(run.setup.bird, run.setup.legs, 0.0).support(r.y[2])[1]
+                        for r in recs])
+    return {
+        "hold_windows": [[a, b] for a, b in windows],
+        "hold_time_s": max((b - a for a, b in windows), default=0.0),
+        "total_hold_s": sum(b - a for a, b in windows),
+        "max_finger_force_N": float(force[k, j]),
+        "max_finger_force_finger": names[j],
+        "max_finger_force_time_s": recs[k].t,
+        "max_force_per_finger_N": {n: float(v) for n, v in zip(names, force.max(axis=0))},
+        "max_lift_m": float(z.max() - z[0]),
+        "max_gap_m": float(gap.max()),
+        "max_pitch_rad": float(np.max(np.abs([r.y[2] for r in recs]))),
+        "events": [[t, name] for t, name in run.trajectory.events],
+        "ok": run.trajectory.ok,
+        "message": run.trajectory.message,
+    }
