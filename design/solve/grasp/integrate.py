@@ -39,7 +39,7 @@ class IntegratorSettings:
     integrator: str = "adaptive"
     rtol: float = 1e-6
     atol: float = 1e-8
-    max_step: float = 2e-3
+    max_step: float = 5e-3
     stepper: str = "rk45"
     step: float = 5.6e-3
 

@@ -1,0 +1,107 @@
+"""The grasp of the thesis's mean bird (issue 4): accuracy against a 4x finer
+run, the reach filter, the thesis's stiffness finding, the legs, the
+baseline integrator. The runs start 0.55 s in (the first finger touches at
+0.685 s; tests/problems.py advances the fingers and the bird alike)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from design.physics.bird import Legs
+from design.solve.grasp.integrate import IntegratorSettings
+from design.solve.grasp.simulation import simulate_grasp
+from tests.problems import thesis_grasp_setup
+
+SKIP, DURATION = 0.55, 0.85
+
+
+@pytest.fixture(scope="module")
+def hard():
+    return simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"))
+
+
+@pytest.fixture(scope="module")
+def hard_fine():
+    return simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"), IntegratorSettings().finer(4))
+
+
+def test_default_integrator_is_within_target_of_a_4x_finer_run(hard, hard_fine):
+    """Issue 4's targets: hold time within 1%, peak finger force within 2%
+    (measured: 0.02% and 0.2%)."""
+    a, b = hard.summary, hard_fine.summary
+    assert a["hold_time_s"] > 0.25
+    assert a["hold_time_s"] == pytest.approx(b["hold_time_s"], rel=0.01)
+    assert a["max_finger_force_N"] == pytest.approx(b["max_finger_force_N"], rel=0.02)
+    assert a["max_finger_force_finger"] == b["max_finger_force_finger"]
+    assert hard.trajectory.steps < hard_fine.trajectory.steps
+
+
+def test_thesis_bdf4_with_frozen_forces_is_far_off(hard_fine):
+    """The thesis's fixed-step BDF-4 with forces frozen over the step: at its
+    5.6 ms step the hold time is 27% short and the peak force 2.3x too high
+    (measured); at a quarter of the step it is within a few percent."""
+    s = thesis_grasp_setup(SKIP, DURATION, "hard")
+    coarse = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=5.6e-3)).summary
+    fine = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=1.4e-3)).summary
+    ref = hard_fine.summary
+    err_coarse = abs(coarse["hold_time_s"] / ref["hold_time_s"] - 1)
+    err_fine = abs(fine["hold_time_s"] / ref["hold_time_s"] - 1)
+    assert err_coarse > 0.1 and err_fine < 0.05 and err_fine < err_coarse / 3
+    assert coarse["max_finger_force_N"] > 1.5 * ref["max_finger_force_N"]
+
+
+def test_reach_filter_changes_nothing_but_the_work(hard):
+    """Fingers that cannot reach the bird are not solved for: same results."""
+    unfiltered = simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"), reach_filter=False)
+    assert np.ravel(unfiltered.summary["hold_windows"]) == pytest.approx(
+        np.ravel(hard.summary["hold_windows"]))
+    assert unfiltered.summary["max_finger_force_N"] == pytest.approx(
+        hard.summary["max_finger_force_N"], rel=1e-9)
+    assert hard.skipped > 0 and unfiltered.skipped == 0
+    assert hard.contact_solves <= unfiltered.contact_solves
+
+
+def test_unreachable_bird_feels_no_finger():
+    s = replace(thesis_grasp_setup(SKIP, 0.3, "hard"), start_x=1.5)
+    run = simulate_grasp(s)
+    assert run.summary["max_finger_force_N"] == 0.0 and run.summary["hold_windows"] == []
+    assert run.contact_solves == 0
+
+
+def test_hard_lower_fingers_hold_longer(hard):
+    """Thesis §5.2 (Figures 5-5 to 5-9): hard (9.07 MPa) lower fingers keep the
+    bird off the belt longer than soft (4.8 MPa) ones (ours: 0.309 s against
+    0.232 s)."""
+    soft = simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "soft")).summary
+    assert hard.summary["hold_time_s"] > 1.2 * soft["hold_time_s"] > 0
+
+
+def test_hold_time_sensitivity_to_the_legs(hard):
+    """The thesis gives no leg stiffness or damping (eq. 4.28). From none to
+    twice the defaults (k = 30 N/m, c = 1.5 N s/m) the hold time changes by
+    under 3% (measured: 0.3085 s at the defaults, 0.3112 s at twice them); a
+    short grasp that starts later, with the same fingers, falls monotonically
+    by 5% from k = 0 to k = 120 N/m."""
+    base = hard.summary["hold_time_s"]
+    times = []
+    for k, c in [(0.0, 0.0), (60.0, 3.0)]:
+        s = replace(thesis_grasp_setup(SKIP, DURATION, "hard"), legs=Legs(k, c))
+        times.append(simulate_grasp(s).summary["hold_time_s"])
+    assert max(abs(t / base - 1) for t in times) < 0.03
+
+
+def test_summary_fields(hard):
+    s = hard.summary
+    for key in ["hold_windows", "hold_time_s", "max_finger_force_N", "max_finger_force_finger",
+                "max_finger_force_time_s", "max_lift_m"]:
+        assert key in s
+    a, b = s["hold_windows"][0]
+    # N = 0 inside the window, > 0 just outside
+    inside = [r for r in hard.trajectory.records if a < r.t < b]
+    assert inside and all(r.normal == 0.0 and r.mode == "air" for r in inside)
+    t_peak = s["max_finger_force_time_s"]
+    peak = max(f.magnitude for r in hard.trajectory.records if r.t == t_peak for f in r.fingers)
+    assert peak == s["max_finger_force_N"]
+    np.testing.assert_allclose(s["max_lift_m"],
+                               max(r.y[1] for r in hard.trajectory.records) - hard.trajectory.records[0].y[1])

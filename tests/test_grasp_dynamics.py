@@ -1,0 +1,107 @@
+"""The bird on the belt: modes, events and impacts against closed forms."""
+
+import numpy as np
+import pytest
+
+from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs
+from design.physics.grasper import Grasper
+from design.solve.grasp.fingers import FingerForces
+from design.solve.grasp.integrate import Grasp, IntegratorSettings, integrate
+
+MEAN = Bird(0.097, 0.066, 0.057, 1.8, 0.00417, "mean")
+FOOTBALL = Bird(0.122, 0.066, 0.066, 0.425, 0.0016, "football")
+
+
+def bare(bird=MEAN, conveyor=Conveyor(0.457), legs=Legs(0.0, 0.0), mu=0.4):
+    """The bird and the belt, no fingers."""
+    fingers = FingerForces(Grasper((), 0.368), bird, 2.0944, mu)
+    return Grasp(BirdDynamics(bird, legs, mu), conveyor, fingers)
+
+
+def energy(bird, y, v):
+    """Kinetic energy in the belt's frame plus gravity's potential, J."""
+    return (0.5 * bird.mass * ((y[3] - v) ** 2 + y[4] ** 2) + 0.5 * bird.inertia * y[5] ** 2
+            + bird.mass * G * y[1])
+
+
+def test_sitting_bird_rides_the_belt():
+    grasp = bare()
+    traj = integrate(grasp, np.array([-0.4, MEAN.gamma, 0.0, 0.457, 0.0, 0.0]), 0.5,
+                     IntegratorSettings())
+    assert traj.ok and not traj.events
+    for r in traj.records:
+        assert r.mode == "stick"
+        assert r.y[0] == pytest.approx(-0.4 + 0.457 * r.t, abs=1e-10)
+        assert r.normal == pytest.approx(MEAN.mass * G, rel=1e-12)
+
+
+@pytest.mark.parametrize("belt", [0.0, 0.3])
+def test_rocking_conserves_energy(belt):
+    """A pitched football released on the belt rocks; rolling without slip and
+    no legs: energy in the belt frame constant to the integrator's tolerance."""
+    grasp = bare(FOOTBALL, Conveyor(belt), mu=1.16)
+    _, D, _, _ = grasp.dyn.support(0.5)
+    traj = integrate(grasp, np.array([0.0, D, 0.5, belt, 0.0, 0.0]), 2.0,
+                     IntegratorSettings(rtol=1e-9, atol=1e-12))
+    e = np.array([energy(FOOTBALL, r.y, belt) for r in traj.records])
+    assert {r.mode for r in traj.records} == {"stick"}
+    assert np.ptp(e) < 1e-6 * e[0]
+    th = np.array([r.y[2] for r in traj.records])
+    assert th.min() == pytest.approx(-0.5, abs=1e-4)      # rocks to the mirror pitch
+
+
+def test_dropped_bird_lands_at_the_free_fall_time():
+    """Released 5 cm above the belt: touch-down at sqrt(2h/g), then it rides."""
+    grasp = bare()
+    h = 0.05
+    traj = integrate(grasp, np.array([0.0, MEAN.gamma + h, 0.0, 0.457, 0.0, 0.0]), 0.3,
+                     IntegratorSettings())
+    assert traj.events[0][1] == "touch-down"
+    # the event fires 1 nm below the belt (GAP_TOL) at ~1 m/s: 1e-9 s late
+    assert traj.events[0][0] == pytest.approx(np.sqrt(2 * h / G), abs=2e-9)
+    after = [r for r in traj.records if r.t > traj.events[0][0]]
+    assert all(r.mode == "stick" and r.y[4] == pytest.approx(0.0, abs=1e-12) for r in after)
+
+
+def test_landing_is_a_plastic_impact():
+    dyn = BirdDynamics(FOOTBALL, Legs(), 1.16)
+    _, D, d1, _ = dyn.support(0.4)
+    y = np.array([0.0, D, 0.4, 0.2, -0.8, -3.0])
+    landed = dyn.land(y)
+    v_n = landed[4] - landed[5] * d1                   # vertical velocity of the lowest point
+    assert v_n == pytest.approx(0.0, abs=1e-14)
+    assert energy(FOOTBALL, landed, 0.0) < energy(FOOTBALL, y, 0.0)
+    assert landed[3] == y[3]                           # frictionless: X momentum kept
+
+
+def test_belt_braking_harder_than_friction_makes_the_bird_slip():
+    """Belt slowing at 10 m/s² > µ g = 3.9 m/s²: the bird slips at once with the
+    friction at -µ N, tips forward (the drag acts below its centre), and sticks
+    again when its lowest point matches the belt; that happens before a sliding
+    block would (0.191 s) because the forward roll carries the lowest point
+    back."""
+    conveyor = Conveyor(0.457, final_speed=0.1, rate=10.0, start_time=0.1)
+    grasp = bare(conveyor=conveyor)
+    traj = integrate(grasp, np.array([0.0, MEAN.gamma, 0.0, 0.457, 0.0, 0.0]), 0.4,
+                     IntegratorSettings())
+    names = [e[1] for e in traj.events]
+    assert names == ["slip", "belt steady", "stick"]
+    assert traj.events[0][0] == pytest.approx(0.1, abs=1e-9)
+    slipping = [r for r in traj.records if r.mode == "slip"]
+    assert slipping and all(r.friction == pytest.approx(-0.4 * r.normal) for r in slipping)
+    assert all(grasp.dyn.slip(r.y, r.belt_speed) > 0 for r in slipping[1:])
+    assert all(r.y[5] > 0 for r in slipping[1:])                  # tips forward
+    t_stick = traj.events[-1][0]
+    assert 0.1357 < t_stick < 0.1 + (0.457 - 0.1) / (0.4 * G)
+    at_stick = min(traj.records, key=lambda r: abs(r.t - t_stick))
+    assert grasp.dyn.slip(at_stick.y, at_stick.belt_speed) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_legs_pull_a_lifted_bird_back():
+    """Leg spring k and damper c (eq. 4.28): a bird held 2 cm up with no support
+    accelerates down at g + k Δz / m."""
+    dyn = BirdDynamics(MEAN, Legs(30.0, 1.5), 0.4)
+    from design.physics.bird import Loads
+    y = np.array([0.0, MEAN.gamma + 0.02, 0.0, 0.0, 0.0, 0.0])
+    acc, n, f = dyn.accelerations(y, Loads(), "air", 0.0)
+    assert acc[1] == pytest.approx(-G - 30.0 * 0.02 / MEAN.mass)

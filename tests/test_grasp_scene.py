@@ -1,0 +1,58 @@
+"""Grasp scenes and the grasper, bird and conveyor files they reference."""
+
+import csv
+from pathlib import Path
+
+import pytest
+import yaml
+
+import design
+from design.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+SCENE = {"kind": "grasp", "grasper": "models/graspers/thesis_table_5_1.yaml",
+         "bird": "models/birds/mean_1_80kg.yaml", "conveyor": {"speed": "18 in/s"},
+         "drum_speed": "20 rpm", "start": {"X": 1.5}, "duration": 0.2}
+
+
+def test_grasp_scene_writes_summary_and_timeseries(tmp_path):
+    result = design.simulate(SCENE, out=tmp_path)
+    assert result["kind"] == "grasp" and result["summary"]["hold_windows"] == []
+    assert result["bird"]["mass"] == 1.8 and result["conveyor"]["speed"] == pytest.approx(0.4572)
+    rows = list(csv.DictReader((tmp_path / "timeseries.csv").open()))
+    assert {"t_s", "X_m", "Z_m", "theta_rad", "N_N", "belt_friction_N", "F4_x_N", "P4_x_m"} <= set(rows[0])
+    assert float(rows[-1]["t_s"]) == pytest.approx(0.2)
+
+
+def test_finger_models_override_a_group():
+    scene = {**SCENE, "finger_models": {"lower": "models/fingers/thesis_nonuniform_soft.yaml"}}
+    result = design.simulate(scene)
+    lower = [f for f in result["grasper"]["fingers"] if f["group"] == "lower"]
+    assert all(f["stiffness"]["E"] == 4.8e6 for f in lower)
+
+
+@pytest.mark.parametrize("change, field, text", [
+    ({"conveyor": {"speed": 0.457, "final_speed": 0.6, "start_time": 0.1}},
+     "conveyor.final_speed", "only decelerations"),
+    ({"conveyor": {"speed": 0.457, "start_time": 0.1, "start_position": -0.1, "final_speed": 0.2}},
+     "conveyor.start_time", "not both"),
+    ({"finger_models": {"middle": "models/fingers/thesis_uniform.yaml"}}, "finger_models.middle",
+     "no finger of the grasper"),
+    ({"bird": "models/birds/ostrich.yaml"}, "bird", "ostrich.yaml' not found"),
+    ({"solver": {"integrator": "euler"}}, "solver.integrator", "adaptive, bdf4"),
+    ({"bird": {"semi_axes": [0.1, 0.06], "mass": 1}}, "bird.semi_axes", "expected a list of 3"),
+    ({"duration": 0}, "duration", "(0, 60]"),
+])
+def test_bad_grasp_input(tmp_path, capsys, change, field, text):
+    path = tmp_path / "scene.yaml"
+    scene = {**SCENE, **change}
+    for key in ("grasper", "bird"):      # files are found from the repository's root
+        if isinstance(scene[key], str):
+            scene[key] = str(ROOT / scene[key])
+    if "finger_models" in scene:
+        scene["finger_models"] = {k: str(ROOT / v) for k, v in scene["finger_models"].items()}
+    path.write_text(yaml.safe_dump(scene))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: {field}: " in err and text in err, err
+    assert not (tmp_path / "out").exists()
