@@ -46,33 +46,8 @@ def tip_distance(a, b) -> float:
 
 def thesis_grasp_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard",
                        bird_file: str = "mean_1_80kg.yaml"):
-    """The mean-bird grasp of Table 5-3 (thesis grasper, hard lower fingers),
-    started ``t_skip`` seconds in: the fingers advanced by ω t_skip and the bird
-    by v t_skip, so that a short run covers the grasp itself."""
-    from dataclasses import replace
-    from pathlib import Path
+    """The mean-bird grasp of Table 5-3 started ``t_skip`` s in (see
+    design.reproduce.grasp.thesis_setup)."""
+    from design.reproduce.grasp import thesis_setup
 
-    from design.io.grasp_scene import read_bird, read_conveyor, read_grasper
-    from design.io.fingers import read_finger
-    from design.io.reader import Reader
-    from design.physics.beam import Finger
-    from design.physics.bird import Legs
-    from design.solve.grasp.simulation import GraspSetup
-
-    models = Path(__file__).resolve().parents[1] / "models"
-    r = Reader("tests")
-    grasper = read_grasper(r, str(models / "graspers" / "thesis_table_5_1.yaml"), "g", models)
-    bird = read_bird(r, str(models / "birds" / bird_file), "b", models)
-    conveyor = read_conveyor(r, str(models / "conveyors" / "constant_0457.yaml"), "c", models)
-    if lower == "soft":
-        soft = read_finger(r, str(models / "fingers" / "thesis_nonuniform_soft.yaml"), "f", models)
-        grasper = replace(grasper, fingers=tuple(
-            replace(f, finger=Finger(f.finger.length, soft.stiffness)) if f.group == "lower"
-            else f for f in grasper.fingers))
-    r.raise_if_any()
-    omega = 20 * 2 * np.pi / 60
-    grasper = replace(grasper, fingers=tuple(
-        replace(f, mount=replace(f.mount, angle=f.mount.angle - omega * t_skip))
-        for f in grasper.fingers))
-    return GraspSetup(grasper, bird, conveyor, omega, -0.457 + conveyor.speed * t_skip, 0.4, 0.4,
-                      Legs(), duration)
+    return thesis_setup(t_skip, duration, lower, bird_file)
