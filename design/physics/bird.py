@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from design.physics.backend import ops
 from design.physics.kinematics import lowest_point
 
 G = 9.81
@@ -84,16 +85,27 @@ class Conveyor:
 
     def velocity(self, t: float, start: float | None) -> tuple[float, float]:
         """Speed (m/s) and acceleration (m/s²) at t, given the start time."""
-        if not self.decelerates or start is None or t <= start:
+        if not self.decelerates or start is None:
             return self.speed, 0.0
-        v = self.speed - self.rate * (t - start)
-        if v <= self.final_speed:
-            return self.final_speed, 0.0
-        return v, -self.rate
+        v, v_dot, _ = belt_motion(t, self.speed, self.final_speed, self.rate, start)
+        return v, v_dot
 
     def describe(self) -> dict:
         return {"speed": self.speed, "final_speed": self.final_speed, "rate": self.rate,
                 "start_time": self.start_time, "start_position": self.start_position}
+
+
+def belt_motion(t, speed, final_speed, rate, start):
+    """Belt speed v (m/s), acceleration (m/s²) and distance travelled since
+    t = 0 (m) when it slows from ``speed`` at ``rate`` to ``final_speed``
+    from time ``start`` on (any argument may be symbolic)."""
+    xp = ops(t, speed, final_speed, rate, start)
+    ramp = (speed - final_speed) / rate
+    tau = xp.fmin(xp.fmax(t - start, 0.0), ramp)
+    v = speed - rate * tau
+    slowing = xp.if_else((t - start > 0) * (t - start < ramp), 1.0, 0.0)
+    travel = speed * t - rate * tau ** 2 / 2 - (speed - final_speed) * xp.fmax(t - start - ramp, 0)
+    return v, -rate * slowing, travel
 
 
 @dataclass
@@ -111,13 +123,13 @@ class BirdDynamics:
     def __init__(self, bird: Bird, legs: Legs, friction: float):
         self.bird, self.legs, self.mu = bird, legs, float(friction)
 
-    def support(self, theta: float) -> tuple[float, float, float, float]:
+    def support(self, theta):
         """Lowest point: (x_A ahead of the centre, D, dD/dθ, d²D/dθ²)."""
         b = self.bird
         x_a, D = lowest_point(b.eta, b.gamma, theta)
         # D² = γ² cos² θ + η² sin² θ: D D' = (η² - γ²) s c, so D' = x_A
         d1 = x_a
-        d2 = ((b.eta ** 2 - b.gamma ** 2) * np.cos(2 * theta) - d1 ** 2) / D
+        d2 = ((b.eta ** 2 - b.gamma ** 2) * ops(theta).cos(2 * theta) - d1 ** 2) / D
         return x_a, D, d1, d2
 
     def gap(self, y: np.ndarray) -> float:
@@ -129,37 +141,36 @@ class BirdDynamics:
         _, D, _, _ = self.support(y[2])
         return float(y[3] - y[5] * D - v)
 
-    def leg_force(self, y: np.ndarray) -> float:
+    def leg_force(self, y):
         return -self.legs.stiffness * (y[1] - self.bird.gamma) - self.legs.damping * y[4]
 
-    def accelerations(self, y: np.ndarray, loads: Loads, mode: str, v_dot: float,
-                      slip_sign: float = 0.0) -> tuple[np.ndarray, float, float]:
-        """(Ẍ, Z̈, θ̈), N and F_c in ``mode``.
+    def accelerations(self, y, loads: Loads, mode: str, v_dot, slip_sign: float = 0.0):
+        """(Ẍ, Z̈, θ̈), N and F_c in ``mode`` (y, loads and v̇ numbers or CasADi
+        symbols; floats N, F_c for numbers).
 
         On the conveyor the constraint Z = D(θ) gives Z̈ = D'' θ̇² + D' θ̈; in
         stick, additionally Ẍ - D θ̈ - D' θ̇² = v̇. Linear in the unknowns.
         """
         b = self.bird
         m, inertia = b.mass, b.inertia
+        xp = ops(y, loads.qx, loads.qz, loads.ty, v_dot)
         fz = loads.qz - m * G + self.leg_force(y)
         if mode == "air":
-            return np.array([loads.qx / m, fz / m, loads.ty / inertia]), 0.0, 0.0
+            return xp.vector([loads.qx / m, fz / m, loads.ty / inertia]), 0.0, 0.0
         x_a, D, d1, d2 = self.support(y[2])
         th_dot = y[5]
         # unknowns u = (Ẍ, Z̈, θ̈, N, F_c); moment of (F_c, N) at A = (x_A, -D) about the
         # centre, about +Y: r_z F_x - r_x F_z = -D F_c - x_A N
-        A = np.zeros((5, 5))
-        r = np.zeros(5)
-        A[0] = [m, 0, 0, 0, -1]; r[0] = loads.qx
-        A[1] = [0, m, 0, -1, 0]; r[1] = fz
-        A[2] = [0, 0, inertia, x_a, D]; r[2] = loads.ty
-        A[3] = [0, 1, -d1, 0, 0]; r[3] = d2 * th_dot ** 2
+        rows = [[m, 0, 0, 0, -1], [0, m, 0, -1, 0], [0, 0, inertia, x_a, D], [0, 1, -d1, 0, 0]]
+        r = [loads.qx, fz, loads.ty, d2 * th_dot ** 2]
         if mode == "slip":
-            A[4] = [0, 0, 0, self.mu * slip_sign, 1]; r[4] = 0.0
+            rows.append([0, 0, 0, self.mu * slip_sign, 1])
+            r.append(0.0)
         else:
-            A[4] = [1, 0, -D, 0, 0]; r[4] = v_dot + d1 * th_dot ** 2
-        u = np.linalg.solve(A, r)
-        return u[:3], float(u[3]), float(u[4])
+            rows.append([1, 0, -D, 0, 0])
+            r.append(v_dot + d1 * th_dot ** 2)
+        u = xp.solve(xp.matrix(rows), xp.vector(r))
+        return u[:3], u[3], u[4]
 
     def rhs(self, y: np.ndarray, loads: Loads, mode: str, v_dot: float,
             slip_sign: float = 0.0) -> np.ndarray:

@@ -119,3 +119,15 @@ def gradient_casadi(x, y, q):
     u, v = c * dx + s * dy, -s * dx + c * dy
     gu, gv = 2 * u / q[3] ** 2, 2 * v / q[4] ** 2
     return ca.vertcat(c * gu - s * gv, s * gu + c * gv)
+
+
+def level_conic(x, y, q):
+    """f(x, y) for a conic q = [cx, cy, B00, B01, B11]: (p - c)ᵀ B (p - c) - 1."""
+    dx, dy = x - q[0], y - q[1]
+    return q[2] * dx ** 2 + 2 * q[3] * dx * dy + q[4] * dy ** 2 - 1
+
+
+def gradient_conic(x, y, q):
+    """∇f for a conic q (CasADi), as a 2-vector (1/m)."""
+    dx, dy = x - q[0], y - q[1]
+    return ca.vertcat(2 * (q[2] * dx + q[3] * dy), 2 * (q[3] * dx + q[4] * dy))

@@ -40,24 +40,68 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from design.physics.backend import ops
 from design.physics.ellipse import Ellipse
 
 MIRROR = np.diag([1.0, -1.0, 1.0])
 
-
-def rot_x(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+# Every formula below takes numbers or CasADi symbols (design/physics/backend.py):
+# the simulator evaluates them, the optimiser differentiates them.
 
 
-def rot_y(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+def rot_x(a):
+    xp = ops(a)
+    c, s = xp.cos(a), xp.sin(a)
+    return xp.matrix([[1, 0, 0], [0, c, -s], [0, s, c]])
 
 
-def rot_z(a: float) -> np.ndarray:
-    c, s = np.cos(a), np.sin(a)
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+def rot_y(a):
+    xp = ops(a)
+    c, s = xp.cos(a), xp.sin(a)
+    return xp.matrix([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+
+
+def rot_z(a):
+    xp = ops(a)
+    c, s = xp.cos(a), xp.sin(a)
+    return xp.matrix([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def finger_frame(angle, height, radius, phi_x, phi_y, spacing, speed, t, x=0.0, tilt=0.0):
+    """Base point (3,) and rotation (3, 3) of a right-drum finger at time t
+    (see :class:`Drum`); any argument may be symbolic."""
+    xp = ops(angle, height, radius, phi_x, phi_y, spacing, speed, t, x, tilt)
+    phi = angle - speed * t
+    r_tilt = rot_y(tilt)
+    local = xp.vector([radius * xp.cos(phi), radius * xp.sin(phi), height])
+    base = xp.vector([x, -spacing / 2, 0.0]) + r_tilt @ local
+    return base, r_tilt @ rot_z(phi) @ rot_y(phi_y) @ rot_x(phi_x)
+
+
+def section(semi_axes, center, pitch, base, R):
+    """The plane z_f = 0 of a finger frame (base, R) cutting the ellipsoid of
+    ``semi_axes`` (η, λ, γ) at ``center`` (3,) pitched by ``pitch``, as a
+    conic in the frame's (x_f, y_f): centre u0 (2,) and matrix B (2, 2) with
+    (u - u0)ᵀ B (u - u0) = 1; B is indefinite or the right-hand side ``rhs``
+    ≤ 0 when the plane misses. Returns (u0, B, rhs).
+
+    Points u of the plane are p_b = d + M u in body coordinates,
+    d = R_bᵀ (base - c), M = R_bᵀ R[:, :2]; the quadric p_bᵀ Q p_b = 1 becomes
+    uᵀ A u + 2 bᵀ u + c0 = 1 with A = Mᵀ Q M.
+    """
+    xp = ops(pitch, base, R, *center, *semi_axes)
+    Rb = rot_y(pitch)
+    d = Rb.T @ (base - xp.vector(list(center)))
+    M = Rb.T @ R[:, :2]
+    Q = xp.matrix([[1 / semi_axes[0] ** 2, 0, 0], [0, 1 / semi_axes[1] ** 2, 0],
+                   [0, 0, 1 / semi_axes[2] ** 2]])
+    A = M.T @ Q @ M
+    b = M.T @ Q @ d
+    c0 = d.T @ Q @ d
+    det = A[0, 0] * A[1, 1] - A[0, 1] * A[1, 0]
+    u0 = -xp.vector([A[1, 1] * b[0] - A[0, 1] * b[1], A[0, 0] * b[1] - A[1, 0] * b[0]]) / det
+    rhs = 1.0 - (c0 + b.T @ u0)
+    return u0, A / rhs, rhs
 
 
 @dataclass(frozen=True)
@@ -92,12 +136,8 @@ class Drum:
 
     def frame(self, mount: FingerMount, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Base point (3,) and rotation (3, 3) of a finger at time t (right drum)."""
-        phi = mount.angle - self.speed * t
-        r_tilt = rot_y(self.tilt)
-        base = self.origin + r_tilt @ np.array([mount.radius * np.cos(phi),
-                                                mount.radius * np.sin(phi), mount.height])
-        R = r_tilt @ rot_z(phi) @ rot_y(mount.phi_y) @ rot_x(mount.phi_x)
-        return base, R
+        return finger_frame(mount.angle, mount.height, mount.radius, mount.phi_x, mount.phi_y,
+                            self.spacing, self.speed, t, self.x, self.tilt)
 
 
 def mirror_frame(base: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -141,24 +181,13 @@ class Ellipsoid:
 
     def cut(self, base: np.ndarray, R: np.ndarray) -> Ellipse | None:
         """The ellipse in which the plane z_f = 0 of a finger frame cuts the
-        ellipsoid, in that frame's (x_f, y_f) coordinates; None if it misses.
-
-        Points u = (x_f, y_f) of the plane are p_b = d + M u in body
-        coordinates, d = R_b^T (base - c), M = R_b^T R[:, :2]; the quadric
-        p_b^T B p_b = 1 becomes u^T A u + 2 b^T u + c0 = 1 with A = M^T B M.
-        """
-        Rb = self.rotation
-        d = Rb.T @ (np.asarray(base, float) - np.asarray(self.center, float))
-        M = Rb.T @ R[:, :2]
-        B = self.matrix
-        A = M.T @ B @ M
-        b = M.T @ B @ d
-        c0 = float(d @ B @ d)
-        u0 = -np.linalg.solve(A, b)
-        rhs = 1.0 - (c0 + float(b @ u0))
+        ellipsoid, in that frame's (x_f, y_f) coordinates; None if it misses
+        (see :func:`section`)."""
+        u0, B, rhs = section((self.eta, self.lam, self.gamma), self.center, self.pitch,
+                             np.asarray(base, float), R)
         if rhs <= 0.0:
             return None
-        vals, vecs = np.linalg.eigh(A / rhs)
+        vals, vecs = np.linalg.eigh(B)
         axes = 1.0 / np.sqrt(vals)
         theta = float(np.arctan2(vecs[1, 0], vecs[0, 0]))
         return Ellipse(float(axes[0]), float(axes[1]), (float(u0[0]), float(u0[1])), theta)
@@ -169,9 +198,10 @@ class Ellipsoid:
         return lowest_point(self.eta, self.gamma, self.pitch)
 
 
-def lowest_point(eta: float, gamma: float, pitch: float) -> tuple[float, float]:
+def lowest_point(eta, gamma, pitch):
     """Offset ahead of the centre and depth D = sqrt(γ² cos²θ + η² sin²θ) of
     the lowest point of an ellipse (η along x, γ along z) pitched by θ."""
-    c, s = np.cos(pitch), np.sin(pitch)
-    D = np.sqrt(gamma ** 2 * c ** 2 + eta ** 2 * s ** 2)
+    xp = ops(eta, gamma, pitch)
+    c, s = xp.cos(pitch), xp.sin(pitch)
+    D = xp.sqrt(gamma ** 2 * c ** 2 + eta ** 2 * s ** 2)
     return (eta ** 2 - gamma ** 2) * s * c / D, D

@@ -21,7 +21,10 @@ force pushes the finger away from the object (checked by the solver).
 
 Parameters q = [l, EI_r, cx, cy, θ, a, b, τµ, h_1..h_K, p...]: finger
 length, reference rigidity, the ellipse in the finger frame, the signed
-friction coefficient, the beam mesh and the stiffness parameters.
+friction coefficient, the beam mesh and the stiffness parameters. With
+``ellipse="conic"`` the ellipse is q[2:7] = [cx, cy, B00, B01, B11]
+((p - c)ᵀ B (p - c) = 1): smooth in the bird's pose even where the cut is a
+circle and its axes are undefined (the optimiser's choice).
 """
 
 from __future__ import annotations
@@ -29,11 +32,14 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
-from design.physics.ellipse import Ellipse, gradient_casadi, level_casadi
+from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, level_casadi,
+                                    level_conic)
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import BeamTranscription, transcription
 
 MODES = ("interior", "tip")
+#: ellipse parameterisations: (level, gradient) functions of (x, y, q[ELLIPSE])
+ELLIPSE_FORMS = {"axes": (level_casadi, gradient_casadi), "conic": (level_conic, gradient_conic)}
 #: index of the ellipse parameters (cx, cy, θ, a, b) in q
 ELLIPSE = slice(2, 7)
 #: index of the signed friction coefficient τµ in q
@@ -51,8 +57,10 @@ class ContactTranscription:
     residual, rootfinder, post, sensitivity : casadi.Function
     """
 
-    def __init__(self, stiffness: Stiffness, intervals: int, degree: int, mode: str):
+    def __init__(self, stiffness: Stiffness, intervals: int, degree: int, mode: str,
+                 ellipse: str = "axes"):
         self.mode = mode
+        level, gradient = ELLIPSE_FORMS[ellipse]
         self.beam = beam = transcription(stiffness, intervals, degree)
         K, nw = beam.K, beam.n_w
         self.n_z = nw + (3 if mode == "interior" else 2)
@@ -69,7 +77,7 @@ class ContactTranscription:
         G = beam.residual(w, P)
         tip = beam.tip(w, P)
         x, y, psi = tip[0], tip[1], tip[2]
-        grad = gradient_casadi(x, y, ell)
+        grad = gradient(x, y, ell)
         normal = grad / ca.norm_2(grad)
         t_f = ca.vertcat(ca.cos(psi), ca.sin(psi))
         along = ca.dot(t_f, normal)
@@ -81,7 +89,7 @@ class ContactTranscription:
         e = normal + tau_mu * t_c
         d = ca.vertcat(-ca.cos(alpha), ca.sin(alpha))
         direction = (d[0] * e[1] - d[1] * e[0]) / ca.norm_2(e)
-        eqs = [G, level_casadi(x, y, ell)]
+        eqs = [G, level(x, y, ell)]
         if mode == "interior":
             eqs.append(along)
         eqs.append(direction)
@@ -92,7 +100,7 @@ class ContactTranscription:
         #: side = n·n_f (> 0: the object is on the finger's -y side, it pushes it to +y)
         self.post = ca.Function(
             f"contact_{mode}_post", [z, q],
-            [ca.vertcat(x, y, psi, force, alpha, L, level_casadi(x, y, ell), along,
+            [ca.vertcat(x, y, psi, force, alpha, L, level(x, y, ell), along,
                         ca.dot(d, e) / ca.norm_2(e), t_c, ca.dot(normal, n_f)),
              ca.mmax(ca.fabs(R))])
         self.shape = ca.Function(f"contact_{mode}_shape", [z, q], beam.shape(w, P))
@@ -103,13 +111,16 @@ class ContactTranscription:
             [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
         self._rootfinders: dict = {}
 
-    def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40) -> ca.Function:
-        """Newton with line search on R(z, q) = 0: (z0, q) -> z (cached)."""
-        key = (tolerance, max_iter)
+    def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40,
+                   error_on_fail: bool = False) -> ca.Function:
+        """Newton with line search on R(z, q) = 0: (z0, q) -> z (cached).
+        ``error_on_fail``: raise instead of returning the last iterate (inside
+        an NLP, where Ipopt then shortens its step)."""
+        key = (tolerance, max_iter, error_on_fail)
         if key not in self._rootfinders:
             self._rootfinders[key] = ca.rootfinder(
                 f"contact_{self.mode}_newton", "newton", self.residual,
-                {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": False,
+                {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
                  "line_search": True, "linear_solver": "qr", "show_eval_warnings": False})
         return self._rootfinders[key]
 
@@ -123,9 +134,10 @@ _CACHE: dict[tuple, ContactTranscription] = {}
 
 
 def contact_transcription(stiffness: Stiffness, intervals: int, degree: int,
-                          mode: str) -> ContactTranscription:
-    """Shared transcription for this stiffness structure, mesh and mode."""
-    key = (stiffness.symbolic_key(), intervals, degree, mode)
+                          mode: str, ellipse: str = "axes") -> ContactTranscription:
+    """Shared transcription for this stiffness structure, mesh, mode and
+    ellipse form."""
+    key = (stiffness.symbolic_key(), intervals, degree, mode, ellipse)
     if key not in _CACHE:
-        _CACHE[key] = ContactTranscription(stiffness, intervals, degree, mode)
+        _CACHE[key] = ContactTranscription(stiffness, intervals, degree, mode, ellipse)
     return _CACHE[key]

@@ -461,7 +461,7 @@ class RobustContact:
             float(psi_l), state.mode == "tip", "push" if state.side > 0 else "pull", friction,
             pose, s, x, y, converged, self.newton_iterations, msg, penetration,
             extras={"residual": float(resid[0]), "friction_ratio": state.tau_mu,
-                    "mode": state.mode, "base_moment": float(moment[0])})
+                    "mode": state.mode, "base_moment": float(moment[0]), "z": state.z.copy()})
 
 
     def _brief(self, state: _State, pose: FingerPose, friction: str, msg: str
@@ -473,7 +473,7 @@ class RobustContact:
             True, float(force), float(alpha), float(arc), (float(x_l), float(y_l)),
             float(psi_l), state.mode == "tip", "push" if state.side > 0 else "pull", friction,
             pose, s, np.array([0.0, x_l]), np.array([0.0, y_l]), True, self.newton_iterations,
-            msg, extras={"friction_ratio": state.tau_mu, "mode": state.mode})
+            msg, extras={"friction_ratio": state.tau_mu, "mode": state.mode, "z": state.z.copy()})
 
 
 def _wrap(angle: float) -> float:
