@@ -182,13 +182,10 @@ class BirdDynamics:
         motion; momentum and moment of momentum about A are balanced."""
         b = self.bird
         x_a, D, _, _ = self.support(y[2])
-        y = y.copy()
-        y[1] = D
         v_n = y[4] - y[5] * x_a                     # vertical velocity of A
         impulse = -v_n / (1 / b.mass + x_a ** 2 / b.inertia)
-        y[4] += impulse / b.mass
-        y[5] += -x_a * impulse / b.inertia
-        return y
+        return ops(y).vector([y[0], D, y[2], y[3], y[4] + impulse / b.mass,
+                              y[5] - x_a * impulse / b.inertia])
 
     def settle(self, y: np.ndarray) -> np.ndarray:
         """Project a state onto the conveyor constraint (Z = D, Ż = D' θ̇)."""

@@ -81,11 +81,17 @@ def _union(a, b):
 
 
 def hold_windows(run: GraspRun) -> list[tuple[float, float]]:
-    """Intervals (s) in which the belt does not support the bird (N = 0)."""
+    """Intervals (s) in which the belt does not support the bird (N = 0). A
+    touch-down ends a window even when the bird bounces straight off: the
+    belt's impulse carried it at that instant."""
     recs = run.trajectory.records
+    impacts = {t for t, name in run.trajectory.events if name == "touch-down"}
     out, start = [], None
     for r in recs:
-        if r.mode == "air" and start is None:
+        if r.mode == "air" and start is not None and r.t in impacts and r.t > start:
+            out.append((start, r.t))
+            start = r.t
+        elif r.mode == "air" and start is None:
             start = r.t
         elif r.mode != "air" and start is not None:
             out.append((start, r.t))

@@ -1,0 +1,348 @@
+"""The design NLP: multiple shooting over the schedule's phases, solved by Ipopt.
+
+Unknowns: the scaled design d ∈ [0, 1]^n, the phase durations T_j and the
+bird's state (X, Z, θ, Ẋ, Ż, θ̇) at every interval node. Each phase j is
+cut into n_j equal intervals of T_j / n_j, integrated by one RK4 step whose
+four stages each evaluate the belt mode's dynamics (design/physics/bird.py)
+with the loads of the fingers in contact there (:mod:`finger_load`: the
+collocated contact solved by an embedded rootfinder, so the constraint
+Jacobian is exact). Constraints:
+
+* continuity between nodes; between phases the event's jump (touch-down:
+  the plastic impact) and the event condition at the switch (lift-off
+  N = 0, touch-down gap = 0, stick→slip |F_c| = µN, slip→stick slip = 0);
+* the mode holds at every node: stick N ≥ 0 and |F_c| ≤ µN, slip N ≥ 0 and
+  the slip keeps its sign, air gap ≥ 0 (complementarity by phases);
+* the bruise cap on every finger's force at every stage;
+* Σ T_j = the horizon, the start on the belt from the closed-form belt
+  motion, the design rules, and the trust region around the current design.
+
+Objective: maximise the hold phase's duration. The Hessian is approximated
+by L-BFGS (the rootfinders' second derivatives are not worth their cost).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import casadi as ca
+import numpy as np
+
+from design.physics.bird import BirdDynamics, Loads, belt_motion
+from design.solve.optimize.finger_load import FingerLoad
+from design.solve.optimize.schedule import STAGES, Schedule, record_at
+from design.solve.optimize.variables import DesignSpace, parameters_of
+
+#: the hold time enters the objective in units of this (s)
+OBJECTIVE_SCALE = 0.1
+#: no phase shorter than this (s)
+MIN_DURATION = 1e-4
+
+
+@dataclass(frozen=True)
+class NLPSettings:
+    """Time grid (s), finger beam mesh, Ipopt limits and options."""
+
+    time_step: float = 0.01
+    beam_intervals: int = 6
+    degree: int = 4
+    max_iter: int = 60
+    tol: float = 1e-6
+    ipopt: dict = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Rules:
+    """Design rules of §5.1 as constraints: drum spacing ≥ λ + σ_λ and ≥
+    every finger's length (5.7); ``bird_spacing`` Δx (m) with ``finger_sets``
+    n fixes the speed ratio v/ω = n Δx / (2π) (5.3-5.4)."""
+
+    sigma_lambda: float = 0.0
+    bird_spacing: float | None = None
+    finger_sets: int = 1
+
+
+@dataclass
+class NLPResult:
+    d: np.ndarray
+    durations: np.ndarray
+    hold_time: float
+    peak_force: float
+    status: str
+    success: bool
+    iterations: int
+    wall_time: float
+    size: dict
+    multipliers: np.ndarray
+    history: list
+
+
+class DesignNLP:
+    """The NLP for one schedule, cap and trust region ``box`` (bounds on d)."""
+
+    def __init__(self, space: DesignSpace, schedule: Schedule, run, cap: float,
+                 settings: NLPSettings, rules: Rules = Rules(), box=None, progress=None):
+        self.space, self.schedule, self.settings = space, schedule, settings
+        self.progress = progress
+        setup = self.setup = space.baseline
+        self.dyn = BirdDynamics(setup.bird, setup.legs, setup.conveyor_friction)
+        used = {i for p in schedule.phases for iv in p.contacts for st in iv
+                for i, c in enumerate(st) if c is not None}
+        self.fingers = {i: FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
+                                      setup.finger_friction, settings.beam_intervals,
+                                      settings.degree) for i in sorted(used)}
+        self._modes = {}
+        self._build(run, cap, rules, box)
+
+    # ------------------------------------------------------------ model
+    def _mode_function(self, mode: str, sign: float) -> ca.Function:
+        """(y, loads, v̇) -> (ẏ, N, F_c) of one belt mode."""
+        key = (mode, sign)
+        if key not in self._modes:
+            y, q, vd = ca.SX.sym("y", 6), ca.SX.sym("q", 3), ca.SX.sym("vd")
+            acc, normal, friction = self.dyn.accelerations(y, Loads(q[0], q[1], q[2]), mode, vd,
+                                                           sign)
+            self._modes[key] = ca.Function(f"bird_{mode}", [y, q, vd],
+                                           [ca.vertcat(y[3:], acc), normal, friction])
+        return self._modes[key]
+
+    def _stage(self, y, t, contacts, values, forces):
+        """Summed finger loads at one stage; appends each finger's force."""
+        total = ca.MX.zeros(3)
+        grasper = self.setup.grasper
+        g = ca.vertcat(values["spacing"], values["drum_speed"])
+        for i, c in enumerate(contacts):
+            if c is None or i not in self.fingers:
+                continue
+            gf = grasper.fingers[i]
+            key = f"fingers.{gf.name}."
+            fp = ca.vertcat(values[key + "angle"], values[key + "height"], gf.mount.radius,
+                            values[key + "phi_x"], values[key + "phi_y"], values[key + "length"])
+            scale = values[f"groups.{gf.group}.stiffness_scale"]
+            out = self.fingers[i].functions[c.mode](y[:3], t, fp, g, scale, c.tau_mu, c.z)
+            total += out[0]
+            forces.append(out[1])
+        return total
+
+    def _belt(self, t, values):
+        c = self.setup.conveyor
+        return belt_motion(t, c.speed, values["conveyor.final_speed"], values["conveyor.rate"],
+                           values["conveyor.start_time"])
+
+    # ------------------------------------------------------------ NLP
+    def _build(self, run, cap, rules, box):
+        sch, space, dyn = self.schedule, self.space, self.dyn
+        n = space.size
+        d = ca.MX.sym("d", n)
+        durations = ca.MX.sym("T", len(sch.phases))
+        values = space.values(d)
+        w, w0, lbw, ubw = [d, durations], [], [], []
+        lo, hi = (np.zeros(n), np.ones(n)) if box is None else box
+        d0 = space.scale(run_values(run, space))
+        w0 += [d0, [p.duration for p in sch.phases]]
+        lbw += [lo, np.full(len(sch.phases), MIN_DURATION)]
+        ubw += [hi, np.full(len(sch.phases), sch.t_end - sch.t_start)]
+        g, lbg, ubg, tags = [], [], [], []
+
+        def constrain(expr, lower, upper, tag):
+            g.append(expr)
+            size = expr.numel()
+            lbg.append(np.full(size, lower))
+            ubg.append(np.full(size, upper))
+            tags.extend([tag] * size)
+
+        forces: list = []
+        mu = dyn.mu
+        t0 = self.setup.start_x
+        # on the belt, untouched, until t_start: the closed-form belt motion
+        v_a, _, travel = self._belt(sch.t_start, values)
+        bird = self.setup.bird
+        start_state = ca.vertcat(t0 + travel, bird.gamma, 0.0, v_a, 0.0, 0.0)
+        previous_end = None
+        t_phase = sch.t_start
+        for j, phase in enumerate(sch.phases):
+            h = durations[j] / phase.intervals
+            nodes = ca.MX.sym(f"y{j}", 6, phase.intervals)
+            w.append(ca.vec(nodes))
+            times = phase.t0 + np.arange(phase.intervals) * phase.duration / phase.intervals
+            w0.append(np.concatenate([record_at(run, tt) for tt in times]))
+            lbw.append(np.tile([-np.inf, 0.0, -1.5, -np.inf, -np.inf, -np.inf], phase.intervals))
+            ubw.append(np.tile([np.inf, 0.5, 1.5, np.inf, np.inf, np.inf], phase.intervals))
+            mode_f = self._mode_function(phase.mode, phase.sign)
+            first = nodes[:, 0]
+            if previous_end is None:
+                constrain(first - start_state, 0.0, 0.0, "start")
+            else:
+                prev = sch.phases[j - 1]
+                jumped = dyn.land(previous_end) if prev.end == "touch-down" else previous_end
+                constrain(first - jumped, 0.0, 0.0, "continuity")
+            for k in range(phase.intervals):
+                y = nodes[:, k]
+                t = t_phase + k * h
+                stage_loads, ks = [], []
+                state = y
+                for s, c in enumerate(STAGES):
+                    ts = t + c * h
+                    if s > 0:
+                        state = y + c * h * ks[-1] if s < 3 else y + h * ks[-1]
+                    q = self._stage(state, ts, phase.contacts[k][s], values, forces)
+                    stage_loads.append(q)
+                    _, v_dot, _ = self._belt(ts, values)
+                    ks.append(mode_f(state, q, v_dot)[0])
+                end = y + h / 6 * (ks[0] + 2 * ks[1] + 2 * ks[2] + ks[3])
+                # the mode holds at the node (its stage-1 loads)
+                _, v_dot, _ = self._belt(t, values)
+                _, normal, friction = mode_f(y, stage_loads[0], v_dot)
+                if k == 0 and j > 0:
+                    self._event(sch.phases[j - 1], y, t, stage_loads[0], values, constrain)
+                if phase.mode == "air":
+                    constrain(y[1] - dyn.support(y[2])[1], 0.0, np.inf, "gap")
+                else:
+                    constrain(normal, 0.0, np.inf, "normal")
+                    if phase.mode == "stick":
+                        constrain(mu * normal - friction, 0.0, np.inf, "friction cone")
+                        constrain(mu * normal + friction, 0.0, np.inf, "friction cone")
+                    else:
+                        v, _, _ = self._belt(t, values)
+                        constrain(phase.sign * (y[3] - y[5] * dyn.support(y[2])[1] - v), 0.0,
+                                  np.inf, "slip sign")
+                if k < phase.intervals - 1:
+                    constrain(nodes[:, k + 1] - end, 0.0, 0.0, "continuity")
+                else:
+                    previous_end = end
+                    if phase.end == "touch-down":
+                        constrain(end[1] - dyn.support(end[2])[1], 0.0, 0.0, "touch-down")
+            t_phase = t_phase + durations[j]
+        constrain(ca.sum1(durations), sch.t_end - sch.t_start, sch.t_end - sch.t_start, "horizon")
+        self.force = ca.vertcat(*forces)
+        if forces:
+            constrain(self.force, -np.inf, cap, "cap")
+        for expr, tag in rule_constraints(values, self.setup, rules):
+            constrain(expr, 0.0, np.inf, tag)
+        x = ca.vertcat(*[ca.vec(v) for v in w])
+        self.x0 = np.concatenate([np.ravel(v) for v in w0])
+        self.lbx, self.ubx = np.concatenate(lbw), np.concatenate(ubw)
+        self.g = ca.vertcat(*g)
+        self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
+        self.tags = tags
+        self.n_design, self.n_phases = n, len(sch.phases)
+        self.f = -durations[sch.hold] / OBJECTIVE_SCALE
+        self.x = x
+        self.functions = ca.Function("nlp", [x], [self.f, self.g, self.force])
+
+    def _event(self, phase, y, t, loads, values, constrain):
+        """The condition that ended ``phase`` at its last state y (time t)."""
+        if phase.end in ("free", "touch-down", "end"):
+            return
+        mode_f = self._mode_function(phase.mode, phase.sign)
+        _, v_dot, _ = self._belt(t, values)
+        _, normal, friction = mode_f(y, loads, v_dot)
+        if phase.end == "lift-off":
+            constrain(normal, 0.0, 0.0, "lift-off")
+        elif phase.end == "slip":                    # friction reached the cone edge
+            constrain(self.dyn.mu * normal - ca.fabs(friction), 0.0, 0.0, "slip starts")
+        elif phase.end == "stick":
+            v, _, _ = self._belt(t, values)
+            constrain(y[3] - y[5] * self.dyn.support(y[2])[1] - v, 0.0, 0.0, "stick starts")
+
+    @property
+    def size(self) -> dict:
+        return {"variables": int(self.x.numel()), "constraints": int(self.g.numel()),
+                "jacobian_nonzeros": int(ca.jacobian_sparsity(self.g, self.x).nnz()),
+                "design_variables": self.n_design, "phases": self.n_phases,
+                "intervals": self.schedule.intervals, "finger_stages": int(self.force.numel())}
+
+    def solve(self) -> NLPResult:
+        s = self.settings
+        history: list = []
+        callback = _Progress(self, history, self.progress)
+        opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
+                          "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0,
+                          "mu_strategy": "adaptive", **s.ipopt},
+                "print_time": False, "iteration_callback": callback,
+                # a rootfinder that fails at a trial point makes Ipopt shorten its step
+                "show_eval_warnings": False}
+        solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
+        t0 = time.perf_counter()
+        sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        wall = time.perf_counter() - t0
+        stats = solver.stats()
+        x = np.asarray(sol["x"]).ravel()
+        n, m = self.n_design, self.n_phases
+        force = np.asarray(self.functions(x)[2]).ravel()
+        return NLPResult(x[:n], x[n:n + m], float(x[n + self.schedule.hold]),
+                         float(force.max()) if force.size else 0.0, stats["return_status"],
+                         bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
+                         np.asarray(sol["lam_x"]).ravel()[:n], history)
+
+
+def run_values(run, space: DesignSpace) -> dict:
+    """The parameter values of the simulated design."""
+    values = parameters_of(run.setup)
+    for gf_base, gf in zip(space.baseline.grasper.fingers, run.setup.grasper.fingers):
+        values[f"groups.{gf.group}.stiffness_scale"] = _scale_of(gf_base, gf)
+    return values
+
+
+def _scale_of(base, finger) -> float:
+    return float(finger.finger.stiffness.ei(np.array([0.0]))[0] /
+                 base.finger.stiffness.ei(np.array([0.0]))[0])
+
+
+def rule_constraints(values: dict, setup, rules: Rules):
+    """(expression ≥ 0, name) of the design rules."""
+    out = [(values["spacing"] - setup.bird.lam - rules.sigma_lambda, "rule 5.7: d >= lambda")]
+    for gf in setup.grasper.fingers:
+        out.append((values["spacing"] - values[f"fingers.{gf.name}.length"],
+                    f"rule 5.7: d >= l ({gf.name})"))
+    if rules.bird_spacing is not None:
+        ratio = rules.finger_sets * rules.bird_spacing / (2 * np.pi)
+        gap = setup.conveyor.speed / values["drum_speed"] - ratio
+        out += [(gap + 1e-6, "rule 5.3: v/omega"), (1e-6 - gap, "rule 5.3: v/omega")]
+    # rules on parameters that are not variables are checked, not constrained
+    return [(e, tag) for e, tag in out if isinstance(e, ca.MX)]
+
+
+class _Progress(ca.Callback):
+    """Ipopt iteration callback: records and reports objective and violation."""
+
+    def __init__(self, nlp: DesignNLP, history: list, progress):
+        ca.Callback.__init__(self)
+        self.nx, self.ng = nlp.x.numel(), nlp.g.numel()
+        self.lbg, self.ubg = nlp.lbg, nlp.ubg
+        self.history, self.report = history, progress
+        self.construct("progress", {})
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        name = ca.nlpsol_out(i)
+        if name == "f":
+            return ca.Sparsity.scalar()
+        if name in ("x", "lam_x"):
+            return ca.Sparsity.dense(self.nx)
+        if name in ("g", "lam_g"):
+            return ca.Sparsity.dense(self.ng)
+        return ca.Sparsity(0, 0)
+
+    def eval(self, arg):
+        g = np.asarray(arg[ca.nlpsol_out().index("g")]).ravel()
+        f = float(arg[ca.nlpsol_out().index("f")])
+        violation = float(np.max(np.concatenate([[0.0], self.lbg - g, g - self.ubg])))
+        self.history.append({"iteration": len(self.history), "hold_time_s": -f * OBJECTIVE_SCALE,
+                             "violation": violation})
+        if self.report:
+            self.report(f"ipopt iteration {len(self.history) - 1}: hold {-f * OBJECTIVE_SCALE:.4f} s,"
+                        f" constraint violation {violation:.2e}")
+        return [0]
