@@ -15,6 +15,7 @@ from pathlib import Path
 
 from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
+from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
 from design.io.results import write_outputs
 from design.io.scene import check_file, load_scene
@@ -22,8 +23,10 @@ from design.run import Progress, RunOutput
 from design.run import beam as beam_run
 from design.run import contact as contact_run
 from design.run import grasp as grasp_run
+from design.run import solve as solve_run
 
-RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run, GraspScene: grasp_run.run}
+RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run, GraspScene: grasp_run.run,
+           DesignProblem: solve_run.run}
 
 
 def run_scene(source: str | Path | Mapping, progress: Progress | None = None) -> RunOutput:
@@ -46,8 +49,22 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
     """
     output = run_scene(source, progress)
     if out is not None:
-        write_outputs(Path(out), output.result, output.tables)
+        write_outputs(Path(out), output.result, output.tables, output.files)
     return output.result
+
+
+def solve(source: str | Path | Mapping, out: str | Path | None = None,
+          progress: Progress | None = None) -> dict:
+    """Solve a design problem (``kind: design``, a path or the file's content):
+    optimise, verify, and return the dict ``design solve`` writes to
+    ``result.json`` (with ``out``, also write it, the CSV tables and
+    ``optimum.yaml`` there). ``result["verification"]["passed"]`` says
+    whether the independent simulation confirmed the design."""
+    scene = load_scene(source)
+    if not isinstance(scene, DesignProblem):
+        raise ValueError("design.solve needs a design problem (kind: design); "
+                         "use design.simulate for scenes")
+    return simulate(source, out, progress)
 
 
 def check(source: str | Path | Mapping) -> object:

@@ -37,12 +37,22 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         return _report_problems(exc)
     name = output.result.get("name") or Path(args.scene).stem
     out = Path(args.out) if args.out else Path("reports") / name
-    written = write_outputs(out, output.result, output.tables)
+    written = write_outputs(out, output.result, output.tables, output.files)
     for path in written:
         print(path)
+    r = output.result
+    if r.get("kind") == "design":
+        v, b = r["verification"], r["baseline"]
+        print(f"{r['status']}: hold {v['hold_time_s']:.4f} s verified (optimiser "
+              f"{r['objective']['hold_time_s']:.4f} s; baseline {b['hold_time_s']:.4f} s), peak "
+              f"finger force {v['max_finger_force_N']:.2f} N (cap {v['cap_N']:.2f} N)")
     if not output.ok:
-        print("warning: not every case converged; see 'converged' and 'message' in result.json",
-              file=sys.stderr)
+        if output.result.get("kind") == "design":
+            print(f"FAILED: {output.result['status']}: {output.result['message']}",
+                  file=sys.stderr)
+        else:
+            print("warning: not every case converged; see 'converged' and 'message' in "
+                  "result.json", file=sys.stderr)
         return EXIT_FAILED
     return EXIT_OK
 
@@ -69,6 +79,11 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", help="solve a scene file and write its results")
     p.add_argument("scene", help="scene file (YAML)")
     p.add_argument("--out", help="output folder (default: reports/<scene name>/)")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("solve", help="optimise a design problem, verify it, write its results")
+    p.add_argument("scene", help="design problem file (YAML, kind: design)")
+    p.add_argument("--out", help="output folder (default: reports/<problem name>/)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=cmd_simulate)
     p = sub.add_parser("check", help="validate input files and report every problem")

@@ -55,13 +55,16 @@ def csv_text(rows: list[dict]) -> str:
     return buf.getvalue()
 
 
-def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]]) -> list[Path]:
-    """Write ``result.json`` and each CSV table; returns the paths written.
+def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]],
+                  texts: dict[str, str] | None = None) -> list[Path]:
+    """Write ``result.json``, each CSV table and further text files; returns
+    the paths written.
 
     Everything is rendered in memory first, so an error leaves no partial file.
     """
     files = {"result.json": json.dumps(jsonable(result), indent=1, allow_nan=False) + "\n"}
     files.update({name: csv_text(rows) for name, rows in tables.items()})
+    files.update(texts or {})
     written = []
     for name, text in files.items():
         write_atomic(out_dir / name, text)

@@ -12,6 +12,7 @@ from pathlib import Path
 from design.errors import ProblemFileError
 from design.io.beam_scene import read_beam
 from design.io.contact_scene import read_contact
+from design.io.design_problem import read_design
 from design.io.grasp_scene import MODEL_READERS, read_grasp
 from design.io.fingers import read_finger
 from design.io.files import load_yaml
@@ -24,6 +25,7 @@ KINDS = {
                 ("sliding", "motion", "solver"), read_contact),
     "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
               ("finger_models", "friction", "legs", "solver"), read_grasp),
+    "design": (("scene", "variables"), ("cap", "rules", "solver"), read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)
 _COMMON = ("kind", "name", "description")

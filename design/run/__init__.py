@@ -17,3 +17,5 @@ class RunOutput:
     tables: dict[str, list[dict]] = field(default_factory=dict)
     #: true when every case converged / the run succeeded
     ok: bool = True
+    #: further text files by name (e.g. the optimum as a scene file)
+    files: dict[str, str] = field(default_factory=dict)

@@ -1,0 +1,222 @@
+"""Design problems (``kind: design``): a baseline grasp, the variables with
+bounds, the bruise cap, the design rules and the solver settings.
+
+.. code-block:: yaml
+
+    kind: design
+    scene: grasp_mean_bird_figure_5_10.yaml     # a grasp scene file, or its content inline
+    variables:                                  # name: [lower, upper]; the rest stay at baseline
+      conveyor.start_time: [0.4 s, 1.2 s]
+      conveyor.final_speed: [0.254 m/s, 0.457 m/s]
+      groups.lower.stiffness_scale: [0.5, 2.0]
+      fingers.4.angle: [-165 deg, -135 deg]
+    cap: baseline              # N | baseline | {relative_to_baseline: 0.75} | a list: Pareto study
+    rules: {sigma_lambda: 0.01, bird_spacing: 0.3, finger_sets: 1}
+    solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
+             trust_region: 0.15, ipopt: {}}
+
+Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
+``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
+``drum_speed``, ``spacing`` (design/solve/optimize/variables.py).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from design.errors import ProblemFileError
+from design.io.files import resolve
+from design.io.grasp_scene import GraspScene
+from design.io.reader import Reader, did_you_mean, join
+from design.solve.optimize.transcription import NLPSettings, Rules
+from design.solve.optimize.trust_region import LoopSettings
+from design.solve.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
+                                             GROUP_FIELDS)
+
+DIMENSIONS = {"angle": "angle", "phi_x": "angle", "phi_y": "angle", "length": "length",
+              "height": "length", "stiffness_scale": "dimensionless", "start_time": "time",
+              "rate": "acceleration", "final_speed": "speed", "drum_speed": "angular_speed",
+              "spacing": "length"}
+
+
+@dataclass(frozen=True)
+class Cap:
+    """The bruise cap: ``value`` N, or ``relative`` × the baseline's verified peak."""
+
+    value: float | None = None
+    relative: float | None = None
+
+    def resolve(self, baseline_peak: float) -> float:
+        return self.value if self.value is not None else self.relative * baseline_peak
+
+    def describe(self) -> str:
+        if self.value is not None:
+            return f"{self.value:g} N"
+        return "the baseline's peak force" if self.relative == 1.0 else \
+            f"{self.relative:g} x the baseline's peak force"
+
+
+@dataclass(frozen=True)
+class DesignProblem:
+    name: str
+    scene: GraspScene
+    variables: dict[str, tuple[float, float]]
+    caps: list[Cap]
+    rules: Rules
+    settings: LoopSettings
+    description: str = ""
+
+    @property
+    def pareto(self) -> bool:
+        return len(self.caps) > 1
+
+
+def variable_names(scene: GraspScene) -> list[str]:
+    names = [f"fingers.{gf.name}.{f}" for gf in scene.grasper.fingers for f in FINGER_FIELDS]
+    names += [f"groups.{g}.{f}" for g in sorted({gf.group for gf in scene.grasper.fingers})
+              for f in GROUP_FIELDS]
+    return names + [f"conveyor.{f}" for f in CONVEYOR_FIELDS] + list(GLOBAL_FIELDS)
+
+
+def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> DesignProblem | None:
+    scene = _scene(reader, data["scene"], base_dir)
+    variables = _variables(reader, data["variables"], scene)
+    caps = _caps(reader, data.get("cap", "baseline"))
+    rules = _rules(reader, data.get("rules", {}))
+    settings = _settings(reader, data.get("solver", {}))
+    if not reader.ok or None in (scene, variables, caps, rules, settings):
+        return None
+    # the loop's simulations use the scene's integrator, with the NLP's finger mesh
+    settings = replace(settings, simulator=scene.settings.integrator)
+    return DesignProblem(name, scene, variables, caps, rules, settings,
+                         data.get("description", ""))
+
+
+def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
+    from design.io.scene import load_scene
+    if isinstance(value, str):
+        path = resolve(value, base_dir)
+        if path is None:
+            reader.add("scene", f"cannot find the grasp scene '{value}'")
+            return None
+        source: object = path
+    elif isinstance(value, Mapping):
+        source = {"kind": "grasp", **value}
+    else:
+        reader.add("scene", "expected a grasp scene file name or the scene's fields")
+        return None
+    try:
+        scene = load_scene(source)
+    except ProblemFileError as exc:
+        for p in exc.problems:
+            if isinstance(value, str):
+                reader.problems.append(p)
+            else:
+                reader.add(join("scene", p.field), p.message)
+        return None
+    if not isinstance(scene, GraspScene):
+        reader.add("scene", "must be a grasp scene (kind: grasp)")
+        return None
+    return scene
+
+
+def _variables(reader: Reader, value: object, scene: GraspScene | None):
+    if not isinstance(value, Mapping):
+        reader.add("variables", "expected a mapping of variable names to [lower, upper]")
+        return None
+    spec = dict(value)
+    if not spec:
+        reader.add("variables", "no design variable given")
+        return None
+    allowed = variable_names(scene) if scene is not None else None
+    out = {}
+    for key, bounds in spec.items():
+        path = join("variables", str(key))
+        if allowed is not None and key not in allowed:
+            reader.add(path, f"no such design variable (allowed: fingers.<name>.<"
+                             f"{'|'.join(FINGER_FIELDS)}>, groups.<group>.stiffness_scale, "
+                             f"conveyor.<{'|'.join(CONVEYOR_FIELDS)}>, drum_speed, spacing)"
+                             f"{did_you_mean(key, allowed)}")
+            continue
+        values = reader.quantities(spec, key, "variables", DIMENSIONS[str(key).rsplit(".")[-1]])
+        if values is None:
+            continue
+        if len(values) != 2:
+            reader.add(path, "expected [lower, upper]")
+        elif not values[0] < values[1]:
+            reader.add(path, f"lower bound {values[0]:g} is not below upper bound {values[1]:g}")
+        elif key.endswith(("stiffness_scale", "rate", "length", "drum_speed", "spacing",
+                           "final_speed")) and values[0] <= 0:
+            reader.add(path, f"lower bound {values[0]:g} must be > 0")
+        else:
+            out[key] = (values[0], values[1])
+    return out
+
+
+def _caps(reader: Reader, value: object) -> list[Cap] | None:
+    items = value if isinstance(value, list) else [value]
+    if not items:
+        reader.add("cap", "an empty list")
+        return None
+    caps = []
+    for i, item in enumerate(items):
+        path = "cap" if not isinstance(value, list) else join("cap", i)
+        if item == "baseline":
+            caps.append(Cap(relative=1.0))
+        elif isinstance(item, Mapping):
+            spec = reader.mapping(item, path, required=("relative_to_baseline",))
+            f = reader.quantity(spec or {}, "relative_to_baseline", path, "dimensionless",
+                                lo=0.0, lo_open=True, hi=10.0) if spec is not None else None
+            if f is not None:
+                caps.append(Cap(relative=f))
+        else:
+            key, holder, field = (i, {i: item}, "cap") if isinstance(value, list) \
+                else ("cap", {"cap": item}, "")
+            v = reader.quantity(holder, key, field, "force", lo=0.0, lo_open=True)
+            if v is not None:
+                caps.append(Cap(value=v))
+    return caps if len(caps) == len(items) else None
+
+
+def _rules(reader: Reader, value: object) -> Rules | None:
+    spec = reader.mapping(value, "rules", optional=("sigma_lambda", "bird_spacing",
+                                                    "finger_sets"))
+    if spec is None:
+        return None
+    sigma = reader.quantity(spec, "sigma_lambda", "rules", "length", lo=0.0, default=0.0)
+    spacing = reader.quantity(spec, "bird_spacing", "rules", "length", lo=0.0, lo_open=True,
+                              default=None)
+    sets = reader.integer(spec, "finger_sets", "rules", lo=1, hi=12, default=1)
+    if None in (sigma, sets):
+        return None
+    return Rules(sigma, spacing, sets)
+
+
+def _settings(reader: Reader, value: object) -> LoopSettings | None:
+    spec = reader.mapping(value, "solver", optional=(
+        "time_step", "beam_intervals", "max_iter", "tolerance", "outer_iterations",
+        "trust_region", "ipopt"))
+    if spec is None:
+        return None
+    d, n = LoopSettings(), NLPSettings()
+    step = reader.quantity(spec, "time_step", "solver", "time", lo=5e-4, hi=0.05,
+                           default=n.time_step)
+    beam = reader.integer(spec, "beam_intervals", "solver", lo=2, hi=32,
+                          default=n.beam_intervals)
+    iters = reader.integer(spec, "max_iter", "solver", lo=1, hi=10000, default=n.max_iter)
+    tol = reader.quantity(spec, "tolerance", "solver", "dimensionless", lo=1e-12, hi=1e-2,
+                          default=n.tol)
+    outer = reader.integer(spec, "outer_iterations", "solver", lo=0, hi=100,
+                           default=d.outer_iterations)
+    radius = reader.quantity(spec, "trust_region", "solver", "dimensionless", lo=0.0,
+                             lo_open=True, hi=1.0, default=d.radius)
+    ipopt = spec.get("ipopt", {})
+    if not isinstance(ipopt, Mapping):
+        reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")
+        return None
+    if None in (step, beam, iters, tol, outer, radius):
+        return None
+    nlp = NLPSettings(step, beam, n.degree, iters, tol, dict(ipopt))
+    return LoopSettings(nlp, outer, radius, d.min_radius, d.simulator, beam)

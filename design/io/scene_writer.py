@@ -1,0 +1,65 @@
+"""Writing a grasp back as a scene file that ``design simulate`` reads as it is."""
+
+from __future__ import annotations
+
+import yaml
+
+from design.io.grasp_scene import GraspSettings
+from design.physics.beam import Finger
+from design.solve.grasp.simulation import GraspSetup
+
+
+def finger_spec(finger: Finger) -> dict:
+    """An inline finger model (SI) for a scene file."""
+    d = dict(finger.stiffness.describe())
+    kind = d.pop("type")
+    if kind == "uniform":
+        return {"length": finger.length, "EI": d["EI"]}
+    return {"length": finger.length, "E": d.pop("E"), "I": {"type": kind, **d}}
+
+
+def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, description: str) -> dict:
+    """The content of a grasp scene file for ``setup`` (SI numbers only)."""
+    g, b, c, i = setup.grasper, setup.bird, setup.conveyor, settings.integrator
+    conveyor = {"speed": c.speed, "rate": c.rate}
+    if c.decelerates:
+        conveyor["final_speed"] = c.final_speed
+        conveyor.update({"start_time": c.start_time} if c.start_time is not None
+                        else {"start_position": c.start_position})
+    return {
+        "kind": "grasp", "name": name, "description": description,
+        "grasper": {"spacing": g.spacing, "tilt": g.tilt, "x": g.x, "fingers": [
+            {"name": gf.name, "group": gf.group, "length": gf.finger.length,
+             "height": gf.mount.height, "drum_radius": gf.mount.radius,
+             "angle": gf.mount.angle, "phi_x": gf.mount.phi_x, "phi_y": gf.mount.phi_y,
+             "finger": finger_spec(gf.finger)} for gf in g.fingers]},
+        "bird": {"name": b.name, "semi_axes": [b.eta, b.lam, b.gamma], "mass": b.mass,
+                 "inertia_y": b.inertia},
+        "conveyor": conveyor,
+        "drum_speed": setup.drum_speed,
+        "start": {"X": setup.start_x},
+        "friction": {"finger": setup.finger_friction, "conveyor": setup.conveyor_friction},
+        "legs": {"stiffness": setup.legs.stiffness, "damping": setup.legs.damping},
+        "duration": setup.duration,
+        "solver": {"integrator": i.integrator, "rtol": i.rtol, "atol": i.atol,
+                   "max_step": i.max_step, "stepper": i.stepper, "step": i.step,
+                   "contact_nodes": settings.contact_nodes,
+                   "reach_filter": settings.reach_filter},
+    }
+
+
+def scene_yaml(spec: dict) -> str:
+    header = "# Written by `design solve`: the optimised design as a grasp scene (SI units).\n"
+    return header + yaml.safe_dump(_plain(spec), sort_keys=False, default_flow_style=None,
+                                   width=100)
+
+
+def _plain(value):
+    """numpy scalars to Python numbers, recursively."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if hasattr(value, "item"):
+        return value.item()
+    return value

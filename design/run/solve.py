@@ -1,0 +1,166 @@
+"""Running a design problem: optimise, verify, tabulate (``design solve``)."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import replace
+
+import numpy as np
+
+from design import __version__
+from design.io.design_problem import DesignProblem
+from design.io.scene_writer import grasp_spec, scene_yaml
+from design.run import Progress, RunOutput
+from design.run.grasp import setup_of, timeseries
+from design.solve.grasp.simulation import simulate_grasp
+from design.solve.optimize.transcription import rule_constraints
+from design.solve.optimize.trust_region import (Outcome, optimise, optimiser_view, verdict,
+                                                verify)
+from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
+                                             timed_conveyor)
+
+#: a scaled variable this close to 0 or 1 sits on its bound
+ACTIVE = 1e-3
+
+
+def design_space(problem: DesignProblem, progress: Progress | None = None) -> DesignSpace:
+    """The problem's variables around its baseline grasp, the belt's
+    deceleration timed (a position trigger becomes the time the baseline's
+    bird reaches it)."""
+    setup = setup_of(problem.scene)
+    conveyor = setup.conveyor
+    start = conveyor.start_time
+    if conveyor.decelerates and start is None:
+        if progress:
+            progress("timing the belt's deceleration from a baseline simulation")
+        run = simulate_grasp(setup, problem.settings.simulator, problem.settings.contact_nodes)
+        slows = [t for t, name in run.trajectory.events if name == "belt slows"]
+        start = slows[0] if slows else setup.duration
+    setup = replace(setup, conveyor=timed_conveyor(conveyor, start))
+    base = parameters_of(setup)
+    return DesignSpace(setup, [Variable(n, lo, hi, base[n])
+                               for n, (lo, hi) in problem.variables.items()])
+
+
+def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
+    t0 = time.perf_counter()
+    say = progress or (lambda message: None)
+    space = design_space(problem, progress)
+    settings = problem.settings
+    d0 = space.scale(space.base_values)
+    say("simulating the baseline at 4x the optimiser's resolution")
+    baseline = verify(space, d0, settings)
+    entries, outcomes, start = [], [], None
+    for k, cap_spec in enumerate(problem.caps):
+        cap = cap_spec.resolve(baseline.peak)
+        say(f"cap {k + 1} of {len(problem.caps)}: {cap:.2f} N ({cap_spec.describe()})")
+        outcome = optimise(space, cap, settings, problem.rules, start, progress)
+        say("the optimiser's view of the design on its own schedule")
+        view = optimiser_view(space, outcome.best, settings, problem.rules)
+        outcome.final = view
+        say("verifying at 4x finer resolution")
+        fine = verify(space, outcome.best.d, settings)
+        entries.append(_entry(space, problem, outcome, view, fine, cap, cap_spec))
+        outcomes.append((outcome, fine))
+        start = outcome.best.d
+    primary, (outcome, fine) = entries[0], outcomes[0]
+    result = {
+        "kind": "design", "name": problem.name, "toolkit_version": __version__,
+        "units": {"length": "m", "force": "N", "angle": "rad", "time": "s",
+                  "speed": "m/s", "acceleration": "m/s^2", "drum_speed": "rad/s"},
+        "description": problem.description,
+        "problem": {"variables": {v.name: {"lower": v.lo, "upper": v.hi, "baseline": v.baseline,
+                                           "unit": v.unit} for v in space.variables},
+                    "caps": [c.describe() for c in problem.caps],
+                    "rules": vars(problem.rules)},
+        **primary,
+        "baseline": {"hold_time_s": baseline.hold,
+                     "hold_windows": baseline.run.summary["hold_windows"],
+                     "max_finger_force_N": baseline.peak,
+                     "max_finger_force_finger": baseline.run.summary["max_finger_force_finger"],
+                     "design": {v.name: v.baseline for v in space.variables}},
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    if problem.pareto:
+        result["pareto"] = [_pareto_row(e) for e in entries]
+    tables = {"design.csv": primary["variables"], "timeseries.csv": timeseries(fine.run)}
+    if problem.pareto:
+        tables["pareto.csv"] = result["pareto"]
+    spec = grasp_spec(space.setup(outcome.best.d), problem.scene.settings,
+                      f"{problem.name}_optimum",
+                      f"Optimised by design solve from {problem.name} (cap "
+                      f"{primary['verification']['cap_N']:.3g} N).")
+    return RunOutput(result, tables, ok=all(e["verification"]["passed"] for e in entries),
+                     files={"optimum.yaml": scene_yaml(spec)})
+
+
+def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, fine, cap,
+           cap_spec) -> dict:
+    best = outcome.best
+    check = verdict(view.hold_time, fine, cap)
+    d = best.d
+    variables = [{"name": v.name, "unit": v.unit, "lower": v.lo, "upper": v.hi,
+                  "baseline": v.baseline, "optimum": v.lo + d[i] * (v.hi - v.lo),
+                  "active_bound": "lower" if d[i] < ACTIVE else "upper" if d[i] > 1 - ACTIVE
+                  else ""} for i, v in enumerate(space.variables)]
+    if check["passed"]:
+        status, message = "verified", "the independent simulation confirms the design"
+    elif not outcome.feasible:
+        status = "infeasible"
+        message = _diagnosis(space, problem, best, cap, variables)
+    else:
+        status = "failed verification"
+        message = (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "
+                   f"optimiser's {view.hold_time:.4f} s, peak {fine.peak:.2f} N against the "
+                   f"cap {cap:.2f} N")
+    iterations = outcome.iterations
+    return {
+        "status": status, "message": message,
+        "design": {v["name"]: v["optimum"] for v in variables},
+        "variables": variables,
+        "objective": {"hold_time_s": view.hold_time,
+                      "grid_step_s": problem.settings.nlp.time_step},
+        "verification": check,
+        "cap": {"N": cap, "given_as": cap_spec.describe()},
+        "solver": {
+            "ipopt_status": outcome.nlp.status if outcome.nlp else
+            (iterations[-1].get("ipopt_status", "not run") if iterations else "not run"),
+            "iterations": int(sum(i.get("ipopt_iterations", 0) for i in iterations)),
+            "outer_iterations": len(iterations),
+            "wall_time_s": outcome.wall_time,
+            "nlp_size": next((i["nlp_size"] for i in reversed(iterations) if "nlp_size" in i),
+                             view.size),
+            "final_nlp": {"ipopt_status": view.status, "iterations": view.iterations,
+                          "wall_time_s": view.wall_time},
+            "history": iterations,
+            "settings": {"time_step_s": problem.settings.nlp.time_step,
+                         "beam_intervals": problem.settings.nlp.beam_intervals,
+                         "max_iter": problem.settings.nlp.max_iter,
+                         "outer_iterations": problem.settings.outer_iterations,
+                         "trust_region": problem.settings.radius,
+                         "ipopt": problem.settings.nlp.ipopt},
+        },
+    }
+
+
+def _diagnosis(space, problem, best, cap, variables) -> str:
+    """Why no design met the cap: the lowest peak reached and what stopped it."""
+    bounds = [f"{v['name']} at its {v['active_bound']} bound" for v in variables
+              if v["active_bound"]]
+    values = space.values(best.d)
+    rules = [tag for expr, tag in rule_constraints(values, space.baseline, problem.rules)
+             if float(expr) < 1e-6]
+    stops = bounds + rules
+    return (f"no design within the bounds keeps every finger under {cap:.2f} N: the smallest "
+            f"peak force reached is {best.peak:.2f} N (finger "
+            f"{best.run.summary['max_finger_force_finger']}); "
+            + ("active: " + ", ".join(stops) if stops else
+               "no bound or rule is active: the trust-region loop stopped at a local optimum"))
+
+
+def _pareto_row(entry: dict) -> dict:
+    v = entry["verification"]
+    return {"cap_N": v["cap_N"], "status": entry["status"],
+            "optimiser_hold_time_s": entry["objective"]["hold_time_s"],
+            "verified_hold_time_s": v["hold_time_s"],
+            "verified_max_finger_force_N": v["max_finger_force_N"], "passed": v["passed"]}
