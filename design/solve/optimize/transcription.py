@@ -23,7 +23,10 @@ by L-BFGS (the rootfinders' second derivatives are not worth their cost).
 
 from __future__ import annotations
 
+import os
+import sys
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import casadi as ca
@@ -74,8 +77,11 @@ class NLPResult:
     iterations: int
     wall_time: float
     size: dict
-    multipliers: np.ndarray
     history: list
+    #: the whole primal-dual solution (CasADi's signs: λ > 0 at an upper bound)
+    x: np.ndarray
+    lam_g: np.ndarray
+    lam_x: np.ndarray
 
 
 class DesignNLP:
@@ -258,14 +264,16 @@ class DesignNLP:
         history: list = []
         callback = _Progress(self, history, self.progress)
         opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
-                          "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0,
+                          "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0, "sb": "yes",
                           "mu_strategy": "adaptive", **s.ipopt},
                 "print_time": False, "iteration_callback": callback,
                 # a rootfinder that fails at a trial point makes Ipopt shorten its step
                 "show_eval_warnings": False}
         solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
         t0 = time.perf_counter()
-        sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
+        with _casadi_output_muted() as streams:
+            callback.streams = streams
+            sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         wall = time.perf_counter() - t0
         stats = solver.stats()
         x = np.asarray(sol["x"]).ravel()
@@ -274,7 +282,23 @@ class DesignNLP:
         return NLPResult(x[:n], x[n:n + m], float(x[n + self.schedule.hold]),
                          float(force.max()) if force.size else 0.0, stats["return_status"],
                          bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
-                         np.asarray(sol["lam_x"]).ravel()[:n], history)
+                         history, x, np.asarray(sol["lam_g"]).ravel(),
+                         np.asarray(sol["lam_x"]).ravel())
+
+
+@contextmanager
+def _casadi_output_muted():
+    """CasADi writes through Python's sys.stdout/sys.stderr; mute them while
+    Ipopt runs (CasADi dumps every input of a rootfinder call that fails at a
+    trial point, and Ipopt then shortens its step: expected, not news).
+    Yields the real streams, for the progress reports."""
+    streams = sys.stdout, sys.stderr
+    with open(os.devnull, "w") as sink:
+        sys.stdout = sys.stderr = sink
+        try:
+            yield streams
+        finally:
+            sys.stdout, sys.stderr = streams
 
 
 def run_values(run, space: DesignSpace) -> dict:
@@ -312,6 +336,7 @@ class _Progress(ca.Callback):
         self.nx, self.ng = nlp.x.numel(), nlp.g.numel()
         self.lbg, self.ubg = nlp.lbg, nlp.ubg
         self.history, self.report = history, progress
+        self.streams = sys.stdout, sys.stderr
         self.construct("progress", {})
 
     def get_n_in(self):
@@ -343,6 +368,11 @@ class _Progress(ca.Callback):
         self.history.append({"iteration": len(self.history), "hold_time_s": -f * OBJECTIVE_SCALE,
                              "violation": violation})
         if self.report:
-            self.report(f"ipopt iteration {len(self.history) - 1}: hold {-f * OBJECTIVE_SCALE:.4f} s,"
-                        f" constraint violation {violation:.2e}")
+            muted = sys.stdout, sys.stderr
+            sys.stdout, sys.stderr = self.streams
+            try:
+                self.report(f"ipopt iteration {len(self.history) - 1}: hold "
+                            f"{-f * OBJECTIVE_SCALE:.4f} s, constraint violation {violation:.2e}")
+            finally:
+                sys.stdout, sys.stderr = muted
         return [0]

@@ -1,0 +1,74 @@
+"""Design problem files: what is accepted, and bad input rejected with one
+clear message per problem, exit status 2 and nothing written."""
+
+from pathlib import Path
+
+import pytest
+import yaml
+
+import design
+from design.cli import main
+from design.errors import ProblemFileError
+from design.io.design_problem import DesignProblem
+
+ROOT = Path(__file__).resolve().parents[1]
+PROBLEM = yaml.safe_load((ROOT / "problems" / "hold_time.yaml").read_text())
+SCENE = str(ROOT / "problems" / "grasp_mean_bird_figure_5_10.yaml")
+
+
+def problem(**change) -> dict:
+    return {**PROBLEM, "scene": SCENE, **change}
+
+
+def test_shipped_problems_are_valid():
+    for name in ("hold_time.yaml", "hold_time_tight_cap.yaml", "hold_time_pareto.yaml",
+                 "football_hold_time.yaml"):
+        p = design.check(ROOT / "problems" / name)
+        assert isinstance(p, DesignProblem) and p.variables
+
+
+def test_units_and_caps_are_read_in_si():
+    p = design.check(problem(variables={"fingers.4.angle": ["-160 deg", "-140 deg"],
+                                        "conveyor.rate": ["50 cm/s^2", "3 m/s^2"]},
+                             cap=[{"relative_to_baseline": 0.75}, "40 N", "baseline"]))
+    lo, hi = p.variables["fingers.4.angle"]
+    assert lo == pytest.approx(-160 * 3.141592653589793 / 180) and hi > lo
+    assert p.variables["conveyor.rate"] == pytest.approx((0.5, 3.0))
+    assert [c.resolve(50.0) for c in p.caps] == pytest.approx([37.5, 40.0, 50.0])
+    assert p.pareto
+
+
+@pytest.mark.parametrize("change, field, text", [
+    ({"variables": {"fingers.4.angle": ["-140 deg", "-160 deg"]}}, "variables.fingers.4.angle",
+     "is not below upper bound"),
+    ({"variables": {"fingers.9.angle": [0, 1]}}, "variables.fingers.9.angle",
+     "no such design variable"),
+    ({"variables": {"groups.lower.stifness_scale": [0.5, 2]}},
+     "variables.groups.lower.stifness_scale", "did you mean"),
+    ({"cap": 0}, "cap", "outside the accepted range"),
+    ({"cap": -5}, "cap", "outside the accepted range"),
+    ({"cap": [30, -1]}, "cap[1]", "outside the accepted range"),
+    ({"cap": {"relative_to_baseline": 0}}, "cap.relative_to_baseline", "outside"),
+    ({"variables": {}}, "variables", "no design variable"),
+    ({"variables": {"groups.lower.stiffness_scale": [0, 2]}},
+     "variables.groups.lower.stiffness_scale", "must be > 0"),
+    ({"solver": {"time_step": 2}}, "solver.time_step", "outside the accepted range"),
+    ({"scene": "no_such_scene.yaml"}, "scene", "cannot find"),
+])
+def test_bad_problem_is_rejected_with_file_and_field(change, field, text):
+    with pytest.raises(ProblemFileError) as err:
+        design.check(problem(**change))
+    assert any(p.field == field and text in p.message for p in err.value.problems), \
+        [str(p) for p in err.value.problems]
+
+
+def test_bad_problem_file_exits_2_and_writes_nothing(tmp_path, capsys):
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(problem(variables={"fingers.4.angle": [1, 0],
+                                                      "fingers.4.colour": [0, 1]}, cap=0)))
+    out = tmp_path / "out"
+    assert main(["solve", str(path), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: variables.fingers.4.angle" in err and "fingers.4.colour" in err
+    assert f"{path}: cap" in err and "3 problems found; nothing was written" in err
+    assert not out.exists()

@@ -1,0 +1,118 @@
+"""The optimiser on a short grasp: KKT conditions checked by finite
+differences, a one-variable problem against exhaustive search, and the
+verification that must catch a design breaking the cap."""
+
+import json
+
+import numpy as np
+import pytest
+
+from design.cli import main
+from design.io.grasp_scene import GraspSettings
+from design.io.scene_writer import grasp_spec
+from design.solve.optimize.schedule import schedule_of
+from design.solve.optimize.transcription import DesignNLP, NLPSettings
+from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, simulate,
+                                                verdict, verify)
+from tests.design_cases import short_setup, stiffness_space
+
+SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
+
+
+def test_kkt_conditions_hold_by_finite_differences():
+    """Stationarity of the Lagrangian (Ipopt's multipliers, derivatives by
+    central differences of the constraint functions, independent of CasADi's
+    AD) and complementarity of every inequality, at a converged optimum with
+    a bound active."""
+    space = stiffness_space("lower", "upper")
+    d0 = space.scale(space.base_values)
+    run = simulate(space, d0, SETTINGS).run
+    nlp = DesignNLP(space, schedule_of(run, 0.01), run, 18.5, SETTINGS.nlp,
+                    box=(np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1)))
+    r = nlp.solve()
+    assert r.success, r.status
+    assert r.peak_force <= 18.5 + 1e-6
+    x, lam_g, lam_x = r.x, r.lam_g, r.lam_x
+    assert np.max(np.abs(lam_x[:space.size])) > 1e-3       # the trust region binds
+
+    def lagrangian_terms(xx):
+        f, g, _ = nlp.functions(xx)
+        return float(f), np.asarray(g).ravel()
+
+    rng = np.random.default_rng(0)
+    n_fixed = space.size + len(nlp.schedule.phases)
+    columns = list(range(n_fixed)) + list(rng.choice(np.arange(n_fixed, x.size), 30, False))
+    h = 1e-6
+    for j in columns:
+        e = np.zeros_like(x)
+        e[j] = h
+        (fp, gp), (fm, gm) = lagrangian_terms(x + e), lagrangian_terms(x - e)
+        grad_f = (fp - fm) / (2 * h)
+        jac_terms = lam_g * (gp - gm) / (2 * h)
+        residual = grad_f + jac_terms.sum() + lam_x[j]
+        scale = 1.0 + abs(grad_f) + np.abs(jac_terms).sum() + abs(lam_x[j])
+        # the rootfinders solve to 1e-10: central differences with h = 1e-6 are
+        # good to ~1e-4 of the terms' size; Ipopt's tolerance is 1e-6 (scaled)
+        assert abs(residual) <= 2e-3 * scale, (j, residual, scale)
+    _, g = lagrangian_terms(x)
+    lower_gap, upper_gap = g - nlp.lbg, nlp.ubg - g
+    inequality = nlp.lbg < nlp.ubg
+    assert np.all(lower_gap[inequality] >= -1e-6) and np.all(upper_gap[inequality] >= -1e-6)
+    slack = np.minimum(lower_gap, upper_gap)[inequality]
+    assert np.max(np.abs(lam_g[inequality]) * np.minimum(slack, 1.0)) < 1e-5
+    # signs: a multiplier pulls only towards the bound that is active
+    assert np.all(lam_g[inequality & (lower_gap > 1e-4)] >= -1e-6)
+    assert np.all(lam_g[inequality & (upper_gap > 1e-4)] <= 1e-6)
+
+
+def test_one_variable_optimum_matches_exhaustive_search():
+    """Upper-finger stiffness alone: the simulated hold over a 0.025 grid of
+    the scale peaks near 0.88 (0.3165 s at 0.9 against 0.3085 s for the
+    baseline); the optimiser, from the baseline, must do at least as well as
+    the grid to within 1 ms."""
+    space = stiffness_space("upper")
+    grid = np.linspace(0.3, 0.5, 9)                 # scales 0.80 ... 1.00
+    holds = [simulate(space, [d], SETTINGS).hold for d in grid]
+    best = int(np.argmax(holds))
+    assert 0 < best < grid.size - 1                 # an interior optimum
+    out = optimise(space, 100.0, LoopSettings(nlp=SETTINGS.nlp, outer_iterations=3))
+    scale = space.design(out.best.d)["groups.upper.stiffness_scale"]
+    assert out.best.hold >= max(holds) - 1e-3
+    assert abs(scale - (0.5 + grid[best])) <= 0.05
+
+
+def test_verification_catches_a_design_over_the_cap():
+    """Stiffer lower fingers press harder: judged against the baseline's own
+    peak as the cap, the verification fails it; the baseline itself passes."""
+    space = stiffness_space("lower", hi=2.0)
+    baseline = verify(space, space.scale(space.base_values), SETTINGS)
+    stiff = verify(space, [1.0], SETTINGS)                       # scale 2
+    assert stiff.peak > 1.05 * baseline.peak
+    failed = verdict(stiff.hold, stiff, baseline.peak)
+    assert not failed["passed"] and failed["max_finger_force_N"] > failed["cap_N"] * 1.01
+    assert verdict(baseline.hold, baseline, baseline.peak)["passed"]
+    assert not verdict(baseline.hold * 1.03, baseline, baseline.peak)["passed"]   # 3% off
+
+
+def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys):
+    """End to end through `design solve`: an optimiser that returned a design
+    over the cap is reported as failed, loudly, with exit status 1."""
+    setup = short_setup()
+    scene = grasp_spec(setup, GraspSettings(contact_nodes=6), "short", "")
+    problem = {"kind": "design", "scene": scene, "cap": "baseline",
+               "variables": {"groups.lower.stiffness_scale": [0.5, 2.0]},
+               "solver": {"time_step": 0.01, "max_iter": 20, "outer_iterations": 0}}
+    path = tmp_path / "problem.yaml"
+    path.write_text(json.dumps(problem))
+
+    def over_the_cap(space, cap, settings, rules, start, progress):
+        base = simulate(space, space.scale(space.base_values), settings)
+        return Outcome(simulate(space, [1.0], settings), base, cap)
+
+    monkeypatch.setattr("design.run.solve.optimise", over_the_cap)
+    assert main(["solve", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1
+    assert "FAILED" in capsys.readouterr().err
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    assert result["status"] == "infeasible" and not result["verification"]["passed"]
+    assert result["verification"]["max_finger_force_N"] > result["verification"]["cap_N"]
+    assert (tmp_path / "out" / "optimum.yaml").exists()
