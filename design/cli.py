@@ -28,13 +28,22 @@ def _report_problems(exc: ProblemFileError) -> int:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from design.api import run_scene
+    from design.api import RUNNERS
+    from design.io.design_problem import DesignProblem
     from design.io.results import write_outputs
+    from design.io.scene import load_scene
 
     try:
-        output = run_scene(args.scene, None if args.quiet else _progress)
+        scene = load_scene(args.scene)
     except ProblemFileError as exc:
         return _report_problems(exc)
+    if (args.command == "solve") != isinstance(scene, DesignProblem):
+        wanted = "a design problem (kind: design)" if args.command == "solve" else "a scene"
+        other = "design simulate" if args.command == "solve" else "design solve"
+        print(f"error: {args.scene}: kind: 'design {args.command}' needs {wanted}; use "
+              f"'{other}' for this file. Nothing was written.", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    output = RUNNERS[type(scene)](scene, None if args.quiet else _progress)
     name = output.result.get("name") or Path(args.scene).stem
     out = Path(args.out) if args.out else Path("reports") / name
     written = write_outputs(out, output.result, output.tables, output.files)

@@ -72,3 +72,12 @@ def test_bad_problem_file_exits_2_and_writes_nothing(tmp_path, capsys):
     assert f"{path}: variables.fingers.4.angle" in err and "fingers.4.colour" in err
     assert f"{path}: cap" in err and "3 problems found; nothing was written" in err
     assert not out.exists()
+
+
+def test_solve_and_simulate_refuse_each_others_files(tmp_path, capsys):
+    out = tmp_path / "out"
+    assert main(["solve", str(ROOT / "problems" / "beam_table_2_3.yaml"), "--out", str(out)]) == 2
+    assert "needs a design problem" in capsys.readouterr().err
+    assert main(["simulate", str(ROOT / "problems" / "hold_time.yaml"), "--out", str(out)]) == 2
+    assert "use 'design solve'" in capsys.readouterr().err
+    assert not out.exists()

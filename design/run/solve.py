@@ -131,7 +131,9 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, f
             "nlp_size": next((i["nlp_size"] for i in reversed(iterations) if "nlp_size" in i),
                              view.size),
             "final_nlp": {"ipopt_status": view.status, "iterations": view.iterations,
-                          "wall_time_s": view.wall_time},
+                          "wall_time_s": view.wall_time,
+                          "constraint_violation": view.history[-1]["violation"]
+                          if view.history else None},
             "history": iterations,
             "settings": {"time_step_s": problem.settings.nlp.time_step,
                          "beam_intervals": problem.settings.nlp.beam_intervals,

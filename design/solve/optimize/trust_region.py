@@ -31,6 +31,8 @@ from design.solve.optimize.variables import DesignSpace
 
 #: verification tolerances: hold time (relative) and force over the cap (relative)
 HOLD_TOLERANCE, CAP_TOLERANCE = 0.02, 0.01
+#: Ipopt iterations allowed for the optimiser's view of a fixed design
+VIEW_MAX_ITER = 150
 #: the NLP's cap is lowered by at most this factor per rejected candidate
 BACK_OFF = 0.9
 
@@ -162,7 +164,9 @@ def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSetti
     """The hold time on the optimiser's grid for a fixed design: the NLP with
     the design's bounds collapsed onto it, on its own simulated schedule."""
     schedule = schedule_of(evaluated.run, settings.nlp.time_step)
-    nlp = DesignNLP(space, schedule, evaluated.run, np.inf, settings.nlp, rules,
+    # only durations and states move: cheap iterations, so allow more of them
+    nlp_settings = replace(settings.nlp, max_iter=max(settings.nlp.max_iter, VIEW_MAX_ITER))
+    nlp = DesignNLP(space, schedule, evaluated.run, np.inf, nlp_settings, rules,
                     (evaluated.d, evaluated.d), progress)
     return nlp.solve()
 
