@@ -5,7 +5,6 @@ verification that must catch a design breaking the cap."""
 import json
 
 import numpy as np
-import pytest
 
 from design.cli import main
 from design.io.grasp_scene import GraspSettings

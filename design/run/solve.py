@@ -13,7 +13,7 @@ from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.transcription import rule_constraints
+from design.solve.optimize.transcription import rule_margins
 from design.solve.optimize.trust_region import (Outcome, optimise, optimiser_view, verdict,
                                                 verify)
 from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
@@ -122,6 +122,9 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, f
                       "grid_step_s": problem.settings.nlp.time_step},
         "verification": check,
         "cap": {"N": cap, "given_as": cap_spec.describe()},
+        "rules_broken": [tag for margin, tag in rule_margins(space.values(np.asarray(d, float)),
+                                                             space.baseline, problem.rules)
+                         if margin < -1e-9],
         "solver": {
             "ipopt_status": outcome.nlp.status if outcome.nlp else
             (iterations[-1].get("ipopt_status", "not run") if iterations else "not run"),
@@ -149,9 +152,9 @@ def _diagnosis(space, problem, best, cap, variables) -> str:
     """Why no design met the cap: the lowest peak reached and what stopped it."""
     bounds = [f"{v['name']} at its {v['active_bound']} bound" for v in variables
               if v["active_bound"]]
-    values = space.values(best.d)
-    rules = [tag for expr, tag in rule_constraints(values, space.baseline, problem.rules)
-             if float(expr) < 1e-6]
+    values = space.values(np.asarray(best.d, float))
+    rules = [tag for margin, tag in rule_margins(values, space.baseline, problem.rules)
+             if margin < 1e-6]
     stops = bounds + rules
     return (f"no design within the bounds keeps every finger under {cap:.2f} N: the smallest "
             f"peak force reached is {best.peak:.2f} N (finger "

@@ -314,8 +314,9 @@ def _scale_of(base, finger) -> float:
                  base.finger.stiffness.ei(np.array([0.0]))[0])
 
 
-def rule_constraints(values: dict, setup, rules: Rules):
-    """(expression ≥ 0, name) of the design rules."""
+def rule_margins(values: dict, setup, rules: Rules) -> list:
+    """(margin ≥ 0 when the rule holds, name) of the design rules, numbers or
+    CasADi expressions as the values are."""
     out = [(values["spacing"] - setup.bird.lam - rules.sigma_lambda, "rule 5.7: d >= lambda")]
     for gf in setup.grasper.fingers:
         out.append((values["spacing"] - values[f"fingers.{gf.name}.length"],
@@ -324,8 +325,13 @@ def rule_constraints(values: dict, setup, rules: Rules):
         ratio = rules.finger_sets * rules.bird_spacing / (2 * np.pi)
         gap = setup.conveyor.speed / values["drum_speed"] - ratio
         out += [(gap + 1e-6, "rule 5.3: v/omega"), (1e-6 - gap, "rule 5.3: v/omega")]
-    # rules on parameters that are not variables are checked, not constrained
-    return [(e, tag) for e, tag in out if isinstance(e, ca.MX)]
+    return out
+
+
+def rule_constraints(values: dict, setup, rules: Rules):
+    """The rules that depend on design variables, as NLP constraints (the
+    others cannot change; the run reports whether they hold)."""
+    return [(e, tag) for e, tag in rule_margins(values, setup, rules) if isinstance(e, ca.MX)]
 
 
 class _Progress(ca.Callback):
