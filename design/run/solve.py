@@ -14,8 +14,7 @@ from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.transcription import rule_margins
-from design.solve.optimize.trust_region import (Outcome, optimise, optimiser_view, verdict,
-                                                verify)
+from design.solve.optimize.trust_region import Outcome, certify, optimise, verdict, verify
 from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
                                              timed_conveyor)
 
@@ -55,12 +54,10 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
         cap = cap_spec.resolve(baseline.peak)
         say(f"cap {k + 1} of {len(problem.caps)}: {cap:.2f} N ({cap_spec.describe()})")
         outcome = optimise(space, cap, settings, problem.rules, start, progress)
-        say("the optimiser's view of the design on its own schedule")
-        view = optimiser_view(space, outcome.best, settings, problem.rules)
-        outcome.final = view
+        claim = certify(space, outcome, settings, problem.rules, progress)
         say("verifying at 4x finer resolution")
         fine = verify(space, outcome.best.d, settings)
-        entries.append(_entry(space, problem, outcome, view, fine, cap, cap_spec))
+        entries.append(_entry(space, problem, outcome, claim, fine, cap, cap_spec))
         outcomes.append((outcome, fine))
         start = outcome.best.d
     primary, (outcome, fine) = entries[0], outcomes[0]
@@ -94,10 +91,11 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
                      files={"optimum.yaml": scene_yaml(spec)})
 
 
-def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, fine, cap,
+def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, fine, cap,
            cap_spec) -> dict:
-    best = outcome.best
-    check = verdict(view.hold_time, fine, cap)
+    best, view = outcome.best, outcome.final
+    claimed, source = claim
+    check = verdict(claimed, fine, cap)
     d = best.d
     variables = [{"name": v.name, "unit": v.unit, "lower": v.lo, "upper": v.hi,
                   "baseline": v.baseline, "optimum": v.lo + d[i] * (v.hi - v.lo),
@@ -111,14 +109,14 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, f
     else:
         status = "failed verification"
         message = (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "
-                   f"optimiser's {view.hold_time:.4f} s, peak {fine.peak:.2f} N against the "
+                   f"optimiser's {claimed:.4f} s, peak {fine.peak:.2f} N against the "
                    f"cap {cap:.2f} N")
     iterations = outcome.iterations
     return {
         "status": status, "message": message,
         "design": {v["name"]: v["optimum"] for v in variables},
         "variables": variables,
-        "objective": {"hold_time_s": view.hold_time,
+        "objective": {"hold_time_s": claimed, "source": source,
                       "grid_step_s": problem.settings.nlp.time_step},
         "verification": check,
         "cap": {"N": cap, "given_as": cap_spec.describe()},
@@ -132,11 +130,11 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, view, f
             "outer_iterations": len(iterations),
             "wall_time_s": outcome.wall_time,
             "nlp_size": next((i["nlp_size"] for i in reversed(iterations) if "nlp_size" in i),
-                             view.size),
-            "final_nlp": {"ipopt_status": view.status, "iterations": view.iterations,
-                          "wall_time_s": view.wall_time,
-                          "constraint_violation": view.history[-1]["violation"]
-                          if view.history else None},
+                             None if view is None else view.size),
+            "final_nlp": None if view is None else {
+                "ipopt_status": view.status, "iterations": view.iterations,
+                "wall_time_s": view.wall_time,
+                "constraint_violation": view.history[-1]["violation"] if view.history else None},
             "history": iterations,
             "settings": {"time_step_s": problem.settings.nlp.time_step,
                          "beam_intervals": problem.settings.nlp.beam_intervals,

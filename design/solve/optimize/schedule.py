@@ -20,11 +20,13 @@ import numpy as np
 
 from design.solve.grasp.simulation import GraspRun
 
-#: phase ends that are events with an equation; "free" ends (a belt mode
-#: decided again after a finger's friction turned) have none
+#: phase ends: the simulation's events. Where the simulator decided the belt
+#: mode again (a finger's friction turned and the forces jumped) the end is
+#: named by the modes it joins and is not exact: the NLP then asks only that
+#: the old mode be over (an inequality), not that it end smoothly
 EVENTS = ("lift-off", "touch-down", "slip", "stick")
 #: which end a merged phase keeps
-PRIORITY = ("touch-down", "lift-off", "slip", "stick", "free")
+PRIORITY = ("touch-down", "lift-off", "slip", "stick")
 #: phases shorter than this (s) are merged into their neighbours (the belt
 #: touched twice within a fraction of a millisecond, say)
 MIN_PHASE = 1e-3
@@ -52,6 +54,8 @@ class Phase:
     t0: float
     t1: float
     end: str
+    #: the end is an event located by the simulator (else a re-decision)
+    exact: bool = True
     intervals: int = 1
     #: contacts[k][s][i]: finger i at stage s of interval k (None: no contact)
     contacts: list = field(default_factory=list)
@@ -88,7 +92,12 @@ def schedule_of(run: GraspRun, time_step: float, margin: float = 0.05) -> Schedu
         raise ValueError("no finger touches the bird in the simulation: nothing to design")
     keys = [_key(r) for r in recs]
     first_change = next((r.t for r, k in zip(recs, keys) if k != keys[0]), recs[-1].t)
-    t_start = max(0.0, min(touching[0], first_change) - margin)
+    # before t_start the bird rides the belt at rest on it: no finger, no change
+    # of belt mode, and a belt at constant speed (slowing, it would roll the bird)
+    conveyor = run.setup.conveyor
+    slows = conveyor.start_time if conveyor.decelerates and \
+        conveyor.final_speed < conveyor.speed else np.inf
+    t_start = max(0.0, min(touching[0], first_change, slows) - margin)
     events = {round(t, 12): name for t, name in run.trajectory.events if name in EVENTS}
     phases: list[Phase] = []
     k0 = int(np.searchsorted(times, t_start, side="right")) - 1
@@ -97,7 +106,8 @@ def schedule_of(run: GraspRun, time_step: float, margin: float = 0.05) -> Schedu
     for r, key in zip(recs[k0 + 1:], keys[k0 + 1:]):
         event = events.get(round(r.t, 12))
         if (key != (mode, sign) or event) and r.t > start:
-            phases.append(Phase(mode, sign, start, r.t, event or "free"))
+            phases.append(Phase(mode, sign, start, r.t, event or _joining((mode, sign), key),
+                                exact=event is not None))
             mode, sign, start = key[0], key[1], r.t
     phases.append(Phase(mode, sign, start, recs[-1].t, "end"))
     phases = _merge_short(phases)
@@ -118,8 +128,8 @@ def schedule_of(run: GraspRun, time_step: float, margin: float = 0.05) -> Schedu
 
 
 def _key(record) -> tuple[str, float]:
-    if record.mode == "slip":
-        return "slip", -float(np.sign(record.friction)) or 1.0
+    if record.mode == "slip":             # F_c = -µ N sgn(slip)
+        return "slip", -float(np.sign(record.friction * record.normal)) or 1.0
     return record.mode, 0.0
 
 
@@ -132,15 +142,26 @@ def _merge_short(phases: list[Phase]) -> list[Phase]:
     for p in phases:
         if out and p.duration < MIN_PHASE and p.end != "end":
             if PRIORITY.index(p.end) < PRIORITY.index(out[-1].end):
-                out[-1].end = p.end
+                out[-1].end, out[-1].exact = p.end, p.exact
             continue
         if out:
             out[-1].t1 = p.t0
-            if (out[-1].mode, out[-1].sign) == (p.mode, p.sign) and out[-1].end == "free":
-                out[-1].t1, out[-1].end = p.t1, p.end
+            if (out[-1].mode, out[-1].sign) == (p.mode, p.sign) and out[-1].end != "touch-down":
+                out[-1].t1, out[-1].end, out[-1].exact = p.t1, p.end, p.exact
                 continue
         out.append(p)
     return out
+
+
+def _joining(before: tuple[str, float], after: tuple[str, float]) -> str:
+    """The event that joins two belt modes: leaving the belt is a lift-off,
+    reaching it a touch-down, stick to slip a slip; anything else (slip to
+    stick, slip reversing) passes through zero slip: a stick."""
+    if after[0] == "air":
+        return "lift-off"
+    if before[0] == "air":
+        return "touch-down"
+    return "slip" if before[0] == "stick" else "stick"
 
 
 def _contacts(recs, times, t: float) -> list[FingerContact | None]:

@@ -53,6 +53,8 @@ class NLPSettings:
     max_iter: int = 60
     tol: float = 1e-6
     ipopt: dict = field(default_factory=dict)
+    #: wall-clock limit of one Ipopt solve (s)
+    max_wall_time: float = 90.0
 
 
 @dataclass(frozen=True)
@@ -85,10 +87,16 @@ class NLPResult:
 
 
 class DesignNLP:
-    """The NLP for one schedule, cap and trust region ``box`` (bounds on d)."""
+    """The NLP for one schedule, cap and trust region ``box`` (bounds on d).
+
+    ``objective``: ``hold`` maximises the hold phase's duration; ``track``
+    stays closest to the simulated phase durations (for a fixed design, whose
+    events pin its timing: the optimiser's own view of a simulated design).
+    """
 
     def __init__(self, space: DesignSpace, schedule: Schedule, run, cap: float,
-                 settings: NLPSettings, rules: Rules = Rules(), box=None, progress=None):
+                 settings: NLPSettings, rules: Rules = Rules(), box=None, progress=None,
+                 objective: str = "hold"):
         self.space, self.schedule, self.settings = space, schedule, settings
         self.progress = progress
         setup = self.setup = space.baseline
@@ -99,6 +107,7 @@ class DesignNLP:
                                       setup.finger_friction, settings.beam_intervals,
                                       settings.degree) for i in sorted(used)}
         self._modes = {}
+        self.objective = objective
         self._build(run, cap, rules, box)
 
     # ------------------------------------------------------------ model
@@ -161,8 +170,11 @@ class DesignNLP:
         forces: list = []
         mu = dyn.mu
         t0 = self.setup.start_x
-        # on the belt, untouched, until t_start: the closed-form belt motion
+        # on the belt, untouched, until t_start: the closed-form belt motion (the
+        # belt must not start slowing before then: it would roll the bird)
         v_a, _, travel = self._belt(sch.t_start, values)
+        if isinstance(values["conveyor.start_time"], ca.MX):
+            constrain(values["conveyor.start_time"] - sch.t_start, 0.0, np.inf, "belt start")
         bird = self.setup.bird
         start_state = ca.vertcat(t0 + travel, bird.gamma, 0.0, v_a, 0.0, 0.0)
         previous_end = None
@@ -181,7 +193,8 @@ class DesignNLP:
                 constrain(first - start_state, 0.0, 0.0, "start")
             else:
                 prev = sch.phases[j - 1]
-                jumped = dyn.land(previous_end) if prev.end == "touch-down" else previous_end
+                jumped = dyn.land(previous_end) if prev.end == "touch-down" and prev.exact \
+                    else previous_end
                 constrain(first - jumped, 0.0, 0.0, "continuity")
             for k in range(phase.intervals):
                 y = nodes[:, k]
@@ -233,24 +246,32 @@ class DesignNLP:
         self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
         self.tags = tags
         self.n_design, self.n_phases = n, len(sch.phases)
-        self.f = -durations[sch.hold] / OBJECTIVE_SCALE
+        if self.objective == "hold":
+            self.f = -durations[sch.hold] / OBJECTIVE_SCALE
+        else:       # "track": the simulated phase durations, where events leave slack
+            simulated = np.array([p.duration for p in sch.phases])
+            self.f = ca.sumsqr((durations - simulated) / self.settings.time_step)
         self.x = x
         self.functions = ca.Function("nlp", [x], [self.f, self.g, self.force])
 
     def _event(self, phase, y, t, loads, values, constrain):
-        """The condition that ended ``phase`` at its last state y (time t)."""
-        if phase.end in ("free", "touch-down", "end"):
+        """The condition that ended ``phase`` at its last state y (time t):
+        an equation for a located event, for a re-decision only that the old
+        mode is over (the finger forces may jump there)."""
+        if phase.end in ("touch-down", "end"):
             return
         mode_f = self._mode_function(phase.mode, phase.sign)
         _, v_dot, _ = self._belt(t, values)
         _, normal, friction = mode_f(y, loads, v_dot)
-        if phase.end == "lift-off":
-            constrain(normal, 0.0, 0.0, "lift-off")
+        if phase.end == "lift-off":                  # the belt stops pushing
+            margin, tag = normal, "lift-off"
         elif phase.end == "slip":                    # friction reached the cone edge
-            constrain(self.dyn.mu * normal - ca.fabs(friction), 0.0, 0.0, "slip starts")
-        elif phase.end == "stick":
+            margin, tag = self.dyn.mu * normal - ca.fabs(friction), "slip starts"
+        else:                                        # the slip came to zero
             v, _, _ = self._belt(t, values)
-            constrain(y[3] - y[5] * self.dyn.support(y[2])[1] - v, 0.0, 0.0, "stick starts")
+            slip = y[3] - y[5] * self.dyn.support(y[2])[1] - v
+            margin, tag = (slip if phase.exact else phase.sign * slip), "stick starts"
+        constrain(margin, 0.0 if phase.exact else -np.inf, 0.0, tag)
 
     @property
     def size(self) -> dict:
@@ -265,6 +286,7 @@ class DesignNLP:
         callback = _Progress(self, history, self.progress)
         opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
                           "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0, "sb": "yes",
+                          "max_wall_time": s.max_wall_time,
                           "mu_strategy": "adaptive", **s.ipopt},
                 "print_time": False, "iteration_callback": callback,
                 # a rootfinder that fails at a trial point makes Ipopt shorten its step
@@ -278,7 +300,11 @@ class DesignNLP:
         stats = solver.stats()
         x = np.asarray(sol["x"]).ravel()
         n, m = self.n_design, self.n_phases
-        force = np.asarray(self.functions(x)[2]).ravel()
+        try:
+            with _casadi_output_muted():
+                force = np.asarray(self.functions(x)[2]).ravel()
+        except RuntimeError:          # Ipopt stopped at a point a contact cannot reach
+            force = np.array([np.inf])
         return NLPResult(x[:n], x[n:n + m], float(x[n + self.schedule.hold]),
                          float(force.max()) if force.size else 0.0, stats["return_status"],
                          bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
@@ -342,6 +368,7 @@ class _Progress(ca.Callback):
         self.nx, self.ng = nlp.x.numel(), nlp.g.numel()
         self.lbg, self.ubg = nlp.lbg, nlp.ubg
         self.history, self.report = history, progress
+        self.hold_index = nlp.n_design + nlp.schedule.hold
         self.streams = sys.stdout, sys.stderr
         self.construct("progress", {})
 
@@ -369,16 +396,16 @@ class _Progress(ca.Callback):
 
     def eval(self, arg):
         g = np.asarray(arg[ca.nlpsol_out().index("g")]).ravel()
-        f = float(arg[ca.nlpsol_out().index("f")])
+        hold = float(arg[ca.nlpsol_out().index("x")][self.hold_index])
         violation = float(np.max(np.concatenate([[0.0], self.lbg - g, g - self.ubg])))
-        self.history.append({"iteration": len(self.history), "hold_time_s": -f * OBJECTIVE_SCALE,
+        self.history.append({"iteration": len(self.history), "hold_time_s": hold,
                              "violation": violation})
         if self.report:
             muted = sys.stdout, sys.stderr
             sys.stdout, sys.stderr = self.streams
             try:
                 self.report(f"ipopt iteration {len(self.history) - 1}: hold "
-                            f"{-f * OBJECTIVE_SCALE:.4f} s, constraint violation {violation:.2e}")
+                            f"{hold:.4f} s, constraint violation {violation:.2e}")
             finally:
                 sys.stdout, sys.stderr = muted
         return [0]
