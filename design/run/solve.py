@@ -49,17 +49,21 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
     d0 = space.scale(space.base_values)
     say("simulating the baseline at 4x the optimiser's resolution")
     baseline = verify(space, d0, settings)
-    entries, outcomes, start = [], [], None
-    for k, cap_spec in enumerate(problem.caps):
-        cap = cap_spec.resolve(baseline.peak)
+    caps = [c.resolve(baseline.peak) for c in problem.caps]
+    entries, outcomes, start = {}, {}, None
+    # tightest cap first: each design is then feasible for the next, looser
+    # cap and warm-starts it, so the hold time cannot fall as the cap rises
+    for k in sorted(range(len(caps)), key=caps.__getitem__):
+        cap_spec, cap = problem.caps[k], caps[k]
         say(f"cap {k + 1} of {len(problem.caps)}: {cap:.2f} N ({cap_spec.describe()})")
         outcome = optimise(space, cap, settings, problem.rules, start, progress)
         claim = certify(space, outcome, settings, problem.rules, progress)
         say("verifying at 4x finer resolution")
         fine = verify(space, outcome.best.d, settings)
-        entries.append(_entry(space, problem, outcome, claim, fine, cap, cap_spec))
-        outcomes.append((outcome, fine))
+        entries[k] = _entry(space, problem, outcome, claim, fine, cap, cap_spec)
+        outcomes[k] = (outcome, fine)
         start = outcome.best.d
+    entries = [entries[k] for k in range(len(caps))]
     primary, (outcome, fine) = entries[0], outcomes[0]
     result = {
         "kind": "design", "name": problem.name, "toolkit_version": __version__,
@@ -79,7 +83,7 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
         "wall_time_s": time.perf_counter() - t0,
     }
     if problem.pareto:
-        result["pareto"] = [_pareto_row(e) for e in entries]
+        result["pareto"] = sorted((_pareto_row(e) for e in entries), key=lambda r: r["cap_N"])
     tables = {"design.csv": primary["variables"], "timeseries.csv": timeseries(fine.run)}
     if problem.pareto:
         tables["pareto.csv"] = result["pareto"]
