@@ -53,8 +53,9 @@ class NLPSettings:
     max_iter: int = 60
     tol: float = 1e-6
     ipopt: dict = field(default_factory=dict)
-    #: wall-clock limit of one Ipopt solve (s)
-    max_wall_time: float = 90.0
+    #: wall-clock limit of one Ipopt solve (s): a safety net only, far above a
+    #: normal solve, since a binding limit makes results depend on machine load
+    max_wall_time: float = 600.0
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ from design.solve.optimize.variables import DesignSpace
 #: verification tolerances: hold time (relative) and force over the cap (relative)
 HOLD_TOLERANCE, CAP_TOLERANCE = 0.02, 0.01
 #: Ipopt iterations allowed for the optimiser's view of a fixed design
-VIEW_MAX_ITER, VIEW_WALL_TIME = 150, 60.0
+VIEW_MAX_ITER = 100
 #: the NLP's cap is lowered by at most this factor per rejected candidate
 BACK_OFF = 0.9
 
@@ -199,8 +199,7 @@ def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSetti
     (None if it cannot be built or evaluated there)."""
     schedule = schedule_of(evaluated.run, settings.nlp.time_step)
     # only durations and states move: cheap iterations, so allow more of them
-    nlp_settings = replace(settings.nlp, max_iter=max(settings.nlp.max_iter, VIEW_MAX_ITER),
-                           max_wall_time=min(settings.nlp.max_wall_time, VIEW_WALL_TIME))
+    nlp_settings = replace(settings.nlp, max_iter=max(settings.nlp.max_iter, VIEW_MAX_ITER))
     try:
         nlp = DesignNLP(space, schedule, evaluated.run, np.inf, nlp_settings, rules,
                         (evaluated.d, evaluated.d), progress, objective="track")
