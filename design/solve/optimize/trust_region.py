@@ -141,7 +141,7 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
         if accepted:
             # stand only on designs whose simulation the optimiser's grid reproduces
             view = optimiser_view(space, candidate, settings, rules, progress)
-            claim = optimiser_hold(view, None)
+            claim = optimiser_hold(view, result)
             reproduced = reproduces(candidate, claim[0])
             accepted = reproduced
         out.iterations.append({
@@ -180,14 +180,19 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
 VIEW_FEASIBLE = 1e-2
 
 
+def feasible(result: NLPResult | None) -> bool:
+    return result is not None and bool(result.history) and \
+        result.history[-1]["violation"] < VIEW_FEASIBLE
+
+
 def optimiser_hold(view: NLPResult | None, accepted: NLPResult | None) -> tuple[float, str]:
     """The hold time (s) the optimiser claims for its design, and where it
     comes from: the fixed-design NLP on the design's own schedule when it
-    converged to feasibility, else the NLP solution the design came from;
-    NaN (a claim that cannot pass verification) if neither exists."""
-    if view is not None and view.history and view.history[-1]["violation"] < VIEW_FEASIBLE:
+    reached feasibility, else the NLP solution the design came from if that
+    did; NaN (a claim that cannot pass verification) if neither."""
+    if feasible(view):
         return view.hold_time, "fixed-design NLP on the design's own schedule"
-    if accepted is not None:
+    if feasible(accepted):
         return accepted.hold_time, "the NLP solve that produced the design"
     return float("nan"), "none: the fixed-design NLP did not converge"
 
