@@ -59,6 +59,8 @@ class Phase:
     intervals: int = 1
     #: contacts[k][s][i]: finger i at stage s of interval k (None: no contact)
     contacts: list = field(default_factory=list)
+    #: the simulated state (intervals, 6) at each interval's start node
+    states: np.ndarray | None = None
 
     @property
     def duration(self) -> float:
@@ -68,8 +70,7 @@ class Phase:
 @dataclass
 class Schedule:
     """Phases covering [t_start, t_end]; ``hold`` indexes the air phase whose
-    duration is the hold time; ``states`` the simulated state at each phase's
-    interval nodes (for the initial guess)."""
+    duration is the hold time."""
 
     phases: list[Phase]
     hold: int
@@ -86,6 +87,7 @@ def schedule_of(run: GraspRun, time_step: float, margin: float = 0.05) -> Schedu
     ``time_step`` (s), over the fingers' contact period padded by ``margin``."""
     recs = run.trajectory.records
     times = np.array([r.t for r in recs])
+    ys = np.array([r.y for r in recs])
     touching = [r.t for r in recs if any(f.solution is not None and f.solution.contact
                                           for f in r.fingers)]
     if not touching:
@@ -124,6 +126,8 @@ def schedule_of(run: GraspRun, time_step: float, margin: float = 0.05) -> Schedu
         p.intervals = max(1, int(round(p.duration / time_step)))
         p.contacts = [[_contacts(recs, times, p.t0 + (k + c) * p.duration / p.intervals)
                        for c in STAGES] for k in range(p.intervals)]
+        nodes = p.t0 + np.arange(p.intervals) * p.duration / p.intervals
+        p.states = np.stack([np.interp(nodes, times, ys[:, j]) for j in range(6)], axis=1)
     return Schedule(phases, hold, t_start, t_end)
 
 
@@ -177,10 +181,3 @@ def _contacts(recs, times, t: float) -> list[FingerContact | None]:
             out.append(FingerContact(s.extras["mode"], s.extras["friction_ratio"],
                                      np.asarray(s.extras["z"], float)))
     return out
-
-
-def record_at(run: GraspRun, t: float) -> np.ndarray:
-    """The simulated state at t (linear between records), for initial guesses."""
-    times = np.array([r.t for r in run.trajectory.records])
-    ys = np.array([r.y for r in run.trajectory.records])
-    return np.array([np.interp(t, times, ys[:, j]) for j in range(ys.shape[1])])

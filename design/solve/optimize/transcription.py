@@ -34,7 +34,7 @@ import numpy as np
 
 from design.physics.bird import BirdDynamics, Loads, belt_motion
 from design.solve.optimize.finger_load import FingerLoad
-from design.solve.optimize.schedule import STAGES, Schedule, record_at
+from design.solve.optimize.schedule import STAGES, Schedule
 from design.solve.optimize.variables import DesignSpace, parameters_of
 
 #: the hold time enters the objective in units of this (s)
@@ -129,7 +129,7 @@ class DesignNLP:
         grasper = self.setup.grasper
         g = ca.vertcat(values["spacing"], values["drum_speed"])
         for i, c in enumerate(contacts):
-            if c is None or i not in self.fingers:
+            if c is None:
                 continue
             gf = grasper.fingers[i]
             key = f"fingers.{gf.name}."
@@ -184,8 +184,7 @@ class DesignNLP:
             h = durations[j] / phase.intervals
             nodes = ca.MX.sym(f"y{j}", 6, phase.intervals)
             w.append(ca.vec(nodes))
-            times = phase.t0 + np.arange(phase.intervals) * phase.duration / phase.intervals
-            w0.append(np.concatenate([record_at(run, tt) for tt in times]))
+            w0.append(phase.states.ravel())
             lbw.append(np.tile([-np.inf, 0.0, -1.5, -np.inf, -np.inf, -np.inf], phase.intervals))
             ubw.append(np.tile([np.inf, 0.5, 1.5, np.inf, np.inf, np.inf], phase.intervals))
             mode_f = self._mode_function(phase.mode, phase.sign)
