@@ -81,6 +81,15 @@ def cmd_check(args: argparse.Namespace) -> int:
     return status
 
 
+def _lazy(module: str, name: str):
+    """A command's function, imported only when the command runs."""
+    def command(args: argparse.Namespace) -> int:
+        import importlib
+
+        return getattr(importlib.import_module(module), name)(args)
+    return command
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="design", description="Optimal design and timing of compliant graspers.")
@@ -95,6 +104,21 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default: reports/<problem name>/)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("tradeoff", help="measure error against wall time for every solver "
+                       "level and resolution; pick the cheapest setting that meets a tolerance")
+    p.add_argument("scene", help="scene or design problem file (YAML)")
+    p.add_argument("--tolerance", type=float,
+                   help="the accuracy wanted, relative to the finest reference (e.g. 0.01)")
+    p.add_argument("--out", help="output folder (default: reports/<name>_tradeoff/)")
+    p.add_argument("--quick", action="store_true", help="fewer resolutions and repetitions")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=_lazy("design.tradeoff.command", "cmd_tradeoff"))
+    p = sub.add_parser("reproduce", help="rerun the thesis's reference cases and write a "
+                       "reproduction report (thesis number, ours, difference, why)")
+    p.add_argument("--out", help="output folder (default: reports/reproduction/)")
+    p.add_argument("--quick", action="store_true", help="skip the slow grasp figures")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=_lazy("design.reproduce.command", "cmd_reproduce"))
     p = sub.add_parser("check", help="validate input files and report every problem")
     p.add_argument("files", nargs="+", help="scene, problem or model files (YAML)")
     p.set_defaults(func=cmd_check)
