@@ -17,8 +17,8 @@ from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
-from design.io.results import write_outputs
 from design.io.scene import check_file, load_scene
+from design.report import write_run
 from design.run import Progress, RunOutput
 from design.run import beam as beam_run
 from design.run import contact as contact_run
@@ -40,7 +40,7 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
     """Solve a scene given as a file path or as the file's content (a mapping).
 
     Returns the dict that ``design simulate`` writes to ``result.json``; with
-    ``out``, also writes it and the CSV tables there.
+    ``out``, also writes it, the CSV tables and report.html there.
 
     Raises
     ------
@@ -49,7 +49,7 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
     """
     output = run_scene(source, progress)
     if out is not None:
-        write_outputs(Path(out), output.result, output.tables, output.files)
+        write_run(Path(out), output)
     return output.result
 
 

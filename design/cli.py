@@ -30,7 +30,7 @@ def _report_problems(exc: ProblemFileError) -> int:
 def cmd_simulate(args: argparse.Namespace) -> int:
     from design.api import RUNNERS
     from design.io.design_problem import DesignProblem
-    from design.io.results import write_outputs
+    from design.report import write_run
     from design.io.scene import load_scene
 
     try:
@@ -46,7 +46,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     output = RUNNERS[type(scene)](scene, None if args.quiet else _progress)
     name = output.result.get("name") or Path(args.scene).stem
     out = Path(args.out) if args.out else Path("reports") / name
-    written = write_outputs(out, output.result, output.tables, output.files)
+    written = write_run(out, output)
     for path in written:
         print(path)
     r = output.result

@@ -1,0 +1,34 @@
+"""Reports: a self-contained ``report.html`` (figures embedded, also written
+as PNG) for every run, built from its result and the runs behind it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from design.io.results import write_outputs
+from design.report.page import Page, write_report
+from design.run import RunOutput
+
+
+def build_report(output: RunOutput) -> Page:
+    """The report of a finished run, by the kind of its scene."""
+    from design.report.beam_contact import beam_page, contact_page
+    from design.report.design import design_page
+    from design.report.grasp import grasp_page
+
+    r, a = output.result, output.artifacts
+    if r["kind"] == "beam":
+        return beam_page(r)
+    if r["kind"] == "contact":
+        return contact_page(r)
+    if r["kind"] == "grasp":
+        return grasp_page(r, a["run"])
+    return design_page(r, a["baseline"], a["optimum"])
+
+
+def write_run(out_dir: Path, output: RunOutput) -> list[Path]:
+    """Write a run's result.json, tables and files, then its report and figures;
+    every file atomically, the report last. Returns the paths written."""
+    page = build_report(output)
+    written = write_outputs(out_dir, output.result, output.tables, output.files)
+    return written + write_report(out_dir, page)

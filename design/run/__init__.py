@@ -19,3 +19,5 @@ class RunOutput:
     ok: bool = True
     #: further text files by name (e.g. the optimum as a scene file)
     files: dict[str, str] = field(default_factory=dict)
+    #: the objects behind the result that its report draws (runs, setups)
+    artifacts: dict = field(default_factory=dict)

@@ -41,7 +41,7 @@ def run(scene: GraspScene, progress: Progress | None = None) -> RunOutput:
     result_run = simulate_grasp(setup_of(scene), s.integrator, s.contact_nodes, s.reach_filter,
                                 progress)
     return RunOutput(result_dict(scene, result_run), {"timeseries.csv": timeseries(result_run)},
-                     ok=result_run.trajectory.ok)
+                     ok=result_run.trajectory.ok, artifacts={"run": result_run})
 
 
 def result_dict(scene: GraspScene, r: GraspRun) -> dict:

@@ -92,7 +92,8 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
                       f"Optimised by design solve from {problem.name} (cap "
                       f"{primary['verification']['cap_N']:.3g} N).")
     return RunOutput(result, tables, ok=all(e["verification"]["passed"] for e in entries),
-                     files={"optimum.yaml": scene_yaml(spec)})
+                     files={"optimum.yaml": scene_yaml(spec)},
+                     artifacts={"baseline": baseline.run, "optimum": fine.run})
 
 
 def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, fine, cap,

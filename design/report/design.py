@@ -1,0 +1,127 @@
+"""The report of a design run (``design solve``)."""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+
+from design.report.grasp import grasp_figures, reproduce_section, summary_rows
+from design.report.page import Page
+from design.solve.grasp.simulation import GraspRun
+
+
+def verification_rows(result: dict) -> list[dict]:
+    """Optimiser against the independent simulation, with each check's verdict."""
+    v = result["verification"]
+    hold_ok = v["hold_time_relative_difference"] <= v["hold_tolerance"]
+    force_ok = v["max_finger_force_N"] <= v["cap_N"] * (1 + v["cap_tolerance"])
+    return [
+        {"check": "longest N = 0 hold (s)", "optimiser": v["optimiser_hold_time_s"],
+         "independent simulation": v["hold_time_s"],
+         "allowed": f"within {100 * v['hold_tolerance']:g} %",
+         "difference": v["hold_time_relative_difference"], "passed": hold_ok},
+        {"check": "peak finger force (N)", "optimiser": v["cap_N"],
+         "independent simulation": v["max_finger_force_N"],
+         "allowed": f"≤ cap + {100 * v['cap_tolerance']:g} %",
+         "difference": v["max_finger_force_N"] / v["cap_N"] - 1, "passed": force_ok}]
+
+
+def convergence_figure(history: list[dict]) -> Figure:
+    """Ipopt's hold time and constraint violation at every iteration, outer
+    trust-region iterations one after another."""
+    fig = Figure(figsize=(11, 4.2))
+    hold, viol = fig.subplots(1, 2)
+    offset = 0
+    for outer in history:
+        steps = outer.get("history") or []
+        if not steps:
+            continue
+        k = offset + np.arange(len(steps))
+        label = f"outer {outer['iteration']}" + (" (accepted)" if outer.get("accepted") else "")
+        hold.plot(k, [s["hold_time_s"] for s in steps], label=label)
+        viol.semilogy(k, [max(s["violation"], 1e-12) for s in steps])
+        offset += len(steps)
+    for ax, label in ((hold, "NLP hold time (s)"), (viol, "largest constraint violation")):
+        ax.set_xlabel("Ipopt iteration (all outer iterations in turn)")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    hold.legend(fontsize=8)
+    return fig
+
+
+def pareto_figure(rows: list[dict], baseline: dict) -> Figure:
+    fig = Figure(figsize=(7, 4.5))
+    ax = fig.add_subplot(1, 1, 1)
+    cap = [r["cap_N"] for r in rows]
+    ax.plot(cap, [r["verified_hold_time_s"] for r in rows], "o-", label="verified")
+    ax.plot(cap, [r["optimiser_hold_time_s"] for r in rows], "x--", label="optimiser")
+    ax.plot([baseline["max_finger_force_N"]], [baseline["hold_time_s"]], "ks", label="baseline")
+    for r in rows:
+        if not r["passed"]:
+            ax.annotate("failed", (r["cap_N"], r["verified_hold_time_s"]), color="r")
+    ax.set_xlabel("bruise cap on every finger (N)")
+    ax.set_ylabel("longest N = 0 hold (s)")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    return fig
+
+
+def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
+    """``baseline`` and ``optimum`` are the independent (fine) simulations."""
+    page = Page(f"Design: {result['name']}")
+    v, b = result["verification"], result["baseline"]
+    ratio = v["hold_time_s"] / b["hold_time_s"] if b["hold_time_s"] > 0 else float("inf")
+    if v["passed"]:
+        page.banner(f"VERIFIED: hold {v['hold_time_s']:.4f} s ({ratio:.2f}x the baseline's "
+                    f"{b['hold_time_s']:.4f} s), peak finger force {v['max_finger_force_N']:.2f} N "
+                    f"under the {v['cap_N']:.2f} N cap. {result['message']}.", "passed")
+    else:
+        page.banner(f"FAILED ({result['status']}): {result['message']}. Do not use this "
+                    "design without reading the verification table.", "failed")
+    page.section("The problem", "problem")
+    page.text(result.get("description") or "")
+    page.text(f"Maximise the longest interval in which the belt does not support the bird "
+              f"(N = 0) with no finger pressing harder than {v['cap_N']:.2f} N "
+              f"({result['cap']['given_as']}) at any instant. Caps: "
+              f"{', '.join(result['problem']['caps'])}. Variables not listed keep the baseline's "
+              f"value.")
+    page.table([{"variable": r["name"], "unit": r["unit"], "lower": r["lower"],
+                 "upper": r["upper"], "baseline": r["baseline"], "optimum": r["optimum"],
+                 "change": r["optimum"] - r["baseline"], "active bound": r["active_bound"]}
+                for r in result["variables"]], "Decision variables (SI)", "variables-table")
+    if result["rules_broken"]:
+        page.text("Design rules broken: " + "; ".join(result["rules_broken"]))
+    page.section("Verification", "verification")
+    page.text(f"The optimiser's hold comes from {result['objective']['source']} on a "
+              f"{result['objective']['grid_step_s'] * 1e3:g} ms grid; the independent simulation "
+              f"is the adaptive grasp simulator at 4x finer resolution.")
+    page.table(verification_rows(result), "Optimiser against the independent simulation",
+               "verification-table")
+    page.table(summary_rows(baseline, "baseline") + summary_rows(optimum, "optimum"),
+               "Baseline and optimum, both from the independent simulation", "summary-table")
+    grasp_figures(page, {"baseline": baseline, "optimum": optimum}, v["cap_N"])
+    page.section("Optimiser convergence", "convergence")
+    history = result["solver"]["history"]
+    page.table([{"outer iteration": h["iteration"], "trust region": h["radius"],
+                 "NLP cap (N)": h.get("nlp_cap_N"), "Ipopt status": h.get("ipopt_status", "error"),
+                 "Ipopt iterations": h.get("ipopt_iterations"),
+                 "NLP hold (s)": h.get("nlp_hold_time_s"),
+                 "simulated hold (s)": h.get("simulated_hold_time_s"),
+                 "simulated peak (N)": h.get("simulated_peak_force_N"),
+                 "accepted": h.get("accepted", False)} for h in history],
+               "Trust-region iterations", "history-table")
+    if any(h.get("history") for h in history):
+        page.figure(convergence_figure(history), "convergence",
+                    "Ipopt convergence: the NLP's hold time and its constraint violation")
+    if result.get("pareto"):
+        page.section("Hold time against the cap", "pareto")
+        page.table(result["pareto"], "Pareto study", "pareto-table")
+        page.figure(pareto_figure(result["pareto"], b), "pareto",
+                    "Verified and optimiser hold time against the bruise cap")
+    s = result["solver"]
+    settings = [{"setting": k, "value": str(val)} for k, val in s["settings"].items()]
+    settings += [{"setting": "Ipopt iterations (all)", "value": str(s["iterations"])},
+                 {"setting": "NLP size", "value": str(s["nlp_size"])}]
+    reproduce_section(page, result, f"design solve {result['name']}.yaml", settings,
+                      result["wall_time_s"])
+    return page

@@ -1,0 +1,85 @@
+"""The report of a grasp scene (``design simulate`` on ``kind: grasp``)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from design.report import grasp_figures as gf
+from design.report.page import Page
+from design.solve.grasp.simulation import GraspRun
+
+
+def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
+    """The run's headline numbers as table rows (quantity, value, unit)."""
+    s = run.summary
+    windows = ", ".join(f"{a:.3f}–{b:.3f}" for a, b in s["hold_windows"]) or "none"
+    rows = [("longest N = 0 hold", s["hold_time_s"], "s"), ("N = 0 windows", windows, "s"),
+            ("peak finger force", s["max_finger_force_N"], "N"),
+            ("finger with the peak", s["max_finger_force_finger"], ""),
+            ("time of the peak", s["max_finger_force_time_s"], "s"),
+            ("centre rise", s["max_lift_m"], "m"), ("lowest point lift", s["max_gap_m"], "m"),
+            ("largest pitch", abs(s["max_pitch_rad"]), "rad")]
+    return [{"quantity": q, **({"run": label} if label else {}), "value": v, "unit": u}
+            for q, v, u in rows]
+
+
+def grasp_figures(page: Page, runs: dict[str, GraspRun], cap: float | None = None) -> None:
+    """The figure sections every grasp report has; the last run in ``runs``
+    is the one drawn in detail."""
+    run = list(runs.values())[-1]
+    page.section("Finger layout on the drums", "layout")
+    page.text("Fingers as mounted at t = 0 (straight, unloaded). The right drum's fingers "
+              "are drawn in full colour, the left drum's mirror images paler.")
+    page.figure(gf.layout_figure({k or 'design': r.setup for k, r in runs.items()}), "layout",
+                "Finger layout: top, side and front views (mm)")
+    page.section("The bird's path", "path")
+    page.figure(gf.path_figure(run), "path",
+                "Side view of the bird and the deflected fingers at key instants; centre "
+                "rise and pitch against time (N = 0 windows shaded)")
+    page.section("Belt normal force", "normal-force")
+    page.figure(gf.normal_force_figure(runs), "normal_force",
+                "Belt normal force N(t); the N = 0 windows of the last run shaded")
+    page.section("Finger forces", "finger-forces")
+    page.figure(gf.finger_force_figure(run, cap), "finger_forces",
+                "Every finger's contact force against time and against the bird's position"
+                + (" with the bruise cap" if cap is not None else ""))
+    page.section("Contact loci on the bird", "contact-loci")
+    page.figure(gf.contact_loci_figure(run), "contact_loci",
+                "Where the fingers pressed on the bird's surface (body frame), coloured by "
+                "force: dots the right drum, crosses the left")
+
+
+def grasp_page(result: dict, run: GraspRun) -> Page:
+    page = Page(f"Grasp simulation: {result['name']}")
+    s = result["summary"]
+    if s["ok"]:
+        page.banner(f"Simulated {result['duration']:.3g} s: longest N = 0 hold "
+                    f"{s['hold_time_s']:.4f} s, peak finger force {s['max_finger_force_N']:.2f} N "
+                    f"(finger {s['max_finger_force_finger']})", "passed")
+    else:
+        page.banner(f"The integration stopped early: {s['message']}", "failed")
+    page.section("Scene", "scene")
+    b = result["bird"]
+    page.text(f"Bird {b.get('name', '')}: semi-axes {np.round(np.array(b['semi_axes']), 4)} m, "
+              f"mass {b.get('mass')} kg, starting at X = {result['start_X']:.3f} m on the belt; "
+              f"drums at {result['drum_speed']:.3f} rad/s, {result['grasper']['spacing']:.3f} m "
+              f"apart; finger friction {result['friction']['finger']}, belt friction "
+              f"{result['friction']['conveyor']}.")
+    page.table([{k: f[k] for k in ("name", "group", "length", "height", "angle", "drum_radius",
+                                   "phi_x", "phi_y")} for f in result["grasper"]["fingers"]],
+               "Fingers of the right drum (m, rad)")
+    page.section("Summary", "summary")
+    page.table(summary_rows(run), "Run summary (SI)", "summary-table")
+    grasp_figures(page, {"": run})
+    reproduce_section(page, result, f"design simulate {result['name']}.yaml",
+                      [{"setting": k, "value": v} for k, v in result["solver"].items()],
+                      result["stats"]["wall_time_s"])
+    return page
+
+
+def reproduce_section(page: Page, result: dict, command: str, settings: list[dict],
+                      wall_time: float) -> None:
+    page.section("Reproduce this run", "reproduce")
+    page.text(f"Toolkit version {result['toolkit_version']}; wall time {wall_time:.1f} s. "
+              f"Command: {command}")
+    page.table(settings, "Solver settings", "settings-table")

@@ -1,0 +1,246 @@
+"""Figures of a grasp run: layout, path, belt force, finger forces, contact loci.
+
+Conventions: world X along the belt, Y across it (the right drum at
+Y = -spacing/2), Z up; the bird's body frame x (length), y (width), z
+(height). Lengths in the figures are mm, forces N, times s. Only the right
+drum's fingers are listed; the left drum mirrors them (Y → -Y).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Circle, Rectangle
+from matplotlib.patches import Ellipse as EllipsePatch
+
+from design.solve.grasp.simulation import GraspRun, GraspSetup
+
+MM = 1e3
+#: one colour per finger, in grasper order
+COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
+           "#7f7f7f", "#bcbd22", "#17becf"]
+
+
+def finger_curves(setup: GraspSetup, t: float, states=None) -> list[np.ndarray]:
+    """World points (3, n) of every right-drum finger at time t: the deflected
+    shape where a contact solution is given, else the straight finger."""
+    drum = setup.grasper.drum(setup.drum_speed)
+    curves = []
+    for i, gf in enumerate(setup.grasper.fingers):
+        base, R = drum.frame(gf.mount, t)
+        sol = None if states is None else states[i].solution
+        if sol is not None and sol.contact:
+            local = np.vstack([sol.shape_x, sol.shape_y])
+        else:
+            local = np.vstack([np.linspace(0.0, gf.finger.length, 2), np.zeros(2)])
+        curves.append(base[:, None] + R[:, :2] @ local)
+    return curves
+
+
+def _bird_outline(setup: GraspSetup, y: np.ndarray, plane: str) -> EllipsePatch:
+    """The bird's outline (mm) in the side (X-Z) or front (Y-Z) view."""
+    b = setup.bird
+    if plane == "side":
+        return EllipsePatch((y[0] * MM, y[1] * MM), 2 * b.eta * MM, 2 * b.gamma * MM,
+                            angle=-np.degrees(y[2]), fill=False, color="k", lw=1.2)
+    return EllipsePatch((0.0, y[1] * MM), 2 * b.lam * MM, 2 * b.gamma * MM, fill=False,
+                        color="k", lw=1.2)
+
+
+def _draw_fingers(ax, curves, axes: tuple[int, int], style: str = "-", alpha: float = 1.0,
+                  label_prefix: str = "", names=None) -> None:
+    """Right-drum fingers and their left mirror images projected on two world axes."""
+    for i, c in enumerate(curves):
+        colour = COLOURS[i % len(COLOURS)]
+        label = f"{label_prefix}finger {names[i]}" if names else None
+        ax.plot(c[axes[0]] * MM, c[axes[1]] * MM, style, color=colour, alpha=alpha, lw=2,
+                label=label)
+        if 1 in axes:       # the mirror image is distinct only where Y is drawn
+            m = c * np.array([[1.0], [-1.0], [1.0]])
+            ax.plot(m[axes[0]] * MM, m[axes[1]] * MM, style, color=colour, alpha=alpha * 0.5,
+                    lw=2)
+
+
+def layout_figure(setups: dict[str, GraspSetup], t: float = 0.0) -> Figure:
+    """The fingers as mounted (straight, unloaded) at time t, in top (X-Y),
+    side (X-Z) and front (Y-Z) views; one line style per design."""
+    fig = Figure(figsize=(13, 4.4))
+    axes = fig.subplots(1, 3)
+    styles = ["-", "--", ":"]
+    for k, (label, setup) in enumerate(setups.items()):
+        g = setup.grasper
+        names = [f.name for f in g.fingers] if k == 0 else None
+        curves = finger_curves(setup, t)
+        for ax, pair in zip(axes, [(0, 1), (0, 2), (1, 2)]):
+            _draw_fingers(ax, curves, pair, styles[k % 3], 1.0 if k == 0 else 0.8,
+                          "", names if ax is axes[0] else None)
+        radius = max(f.mount.radius for f in g.fingers)
+        low, high = (min(f.mount.height for f in g.fingers), max(f.mount.height for f in g.fingers))
+        for side in (-1, 1):
+            centre = side * g.spacing / 2
+            outline = dict(fill=False, ls=styles[k % 3], color="0.4")
+            axes[0].add_patch(Circle((g.x * MM, centre * MM), radius * MM, **outline))
+            axes[2].add_patch(Rectangle(((centre - radius) * MM, low * MM), 2 * radius * MM,
+                                        (high - low) * MM, **outline))
+        axes[1].add_patch(Rectangle(((g.x - radius) * MM, low * MM), 2 * radius * MM,
+                                    (high - low) * MM, fill=False, ls=styles[k % 3], color="0.4"))
+        axes[0].plot([], [], styles[k % 3], color="0.2", label=label)
+    for ax, (xl, yl), title in zip(axes, [("X", "Y"), ("X", "Z"), ("Y", "Z")],
+                                   ["top view", "side view", "front view"]):
+        ax.set_xlabel(f"{xl} (mm)")
+        ax.set_ylabel(f"{yl} (mm)")
+        ax.set_title(f"{title}, t = {t:.2f} s")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.grid(alpha=0.3)
+    axes[0].legend(fontsize=7, loc="best")
+    return fig
+
+
+def key_instants(run: GraspRun) -> list[tuple[float, str]]:
+    """First finger contact, start and end of the longest hold, peak force."""
+    s = run.summary
+    recs = run.trajectory.records
+    out = []
+    touching = [r.t for r in recs if any(f.magnitude > 0 for f in r.fingers)]
+    if touching:
+        out.append((touching[0], "first contact"))
+    windows = s["hold_windows"]
+    if windows:
+        a, b = max(windows, key=lambda w: w[1] - w[0])
+        out += [(a, "hold starts"), (b, "hold ends")]
+    out.append((s["max_finger_force_time_s"], "peak force"))
+    return sorted(out)
+
+
+def _record_at(run: GraspRun, t: float):
+    recs = run.trajectory.records
+    return recs[int(np.argmin([abs(r.t - t) for r in recs]))]
+
+
+def path_figure(run: GraspRun) -> Figure:
+    """Side view of the bird's path with the bird and the deflected fingers
+    at the key instants; its height and pitch against time."""
+    setup = run.setup
+    recs = run.trajectory.records
+    t = np.array([r.t for r in recs])
+    y = np.array([r.y for r in recs])
+    instants = key_instants(run)
+    fig = Figure(figsize=(13, 8))
+    top = fig.add_subplot(2, 1, 1)
+    top.plot(y[:, 0] * MM, y[:, 1] * MM, "k-", lw=1, label="bird centre")
+    for k, (tk, name) in enumerate(instants):
+        r = _record_at(run, tk)
+        top.add_patch(_bird_outline(setup, r.y, "side"))
+        _draw_fingers(top, finger_curves(setup, r.t, r.fingers), (0, 2), alpha=0.9,
+                      names=[f.name for f in setup.grasper.fingers] if k == 0 else None)
+        top.annotate(f"{name}\nt = {r.t:.3f} s", (r.y[0] * MM, (r.y[1] + setup.bird.gamma) * MM),
+                     ha="center", va="bottom", fontsize=8)
+    top.axhline(0.0, color="0.3", lw=3, label="belt")
+    top.set_aspect("equal", adjustable="datalim")
+    top.set_xlabel("X (mm)")
+    top.set_ylabel("Z (mm)")
+    top.set_title("side view: the bird and the right drum's fingers at key instants")
+    top.legend(fontsize=7, ncol=3, loc="upper left")
+    ax1 = fig.add_subplot(2, 2, 3)
+    ax1.plot(t, (y[:, 1] - y[0, 1]) * MM)
+    ax1.set_xlabel("t (s)")
+    ax1.set_ylabel("centre rise Z - Z0 (mm)")
+    ax2 = fig.add_subplot(2, 2, 4)
+    ax2.plot(t, np.degrees(y[:, 2]))
+    ax2.set_xlabel("t (s)")
+    ax2.set_ylabel("pitch θ (°)")
+    for ax in (ax1, ax2):
+        ax.grid(alpha=0.3)
+        _shade(ax, run.summary["hold_windows"])
+    return fig
+
+
+def _shade(ax, windows) -> None:
+    for k, (a, b) in enumerate(windows):
+        ax.axvspan(a, b, color="tab:green", alpha=0.15, label="N = 0" if k == 0 else None)
+
+
+def normal_force_figure(runs: dict[str, GraspRun]) -> Figure:
+    """The belt's normal force N(t) with the N = 0 windows shaded, and the
+    belt speed."""
+    fig = Figure(figsize=(11, 4.2))
+    ax = fig.add_subplot(1, 1, 1)
+    speed = ax.twinx()
+    for k, (label, run) in enumerate(runs.items()):
+        recs = run.trajectory.records
+        t = [r.t for r in recs]
+        ax.plot(t, [r.normal for r in recs], "-" if k == 0 else "--", label=f"N, {label}")
+        speed.plot(t, [r.belt_speed for r in recs], ":", color="0.4" if k == 0 else "0.7",
+                   label=f"belt speed, {label}")
+    _shade(ax, list(runs.values())[-1].summary["hold_windows"])
+    ax.set_xlabel("t (s)")
+    ax.set_ylabel("belt normal force N (N)")
+    speed.set_ylabel("belt speed (m/s)")
+    ax.grid(alpha=0.3)
+    lines = ax.get_legend_handles_labels()
+    more = speed.get_legend_handles_labels()
+    ax.legend(lines[0] + more[0], lines[1] + more[1], fontsize=8, loc="upper right")
+    return fig
+
+
+def finger_force_figure(run: GraspRun, cap: float | None = None) -> Figure:
+    """Every finger's contact force against time and against the bird's X,
+    with the cap."""
+    recs = run.trajectory.records
+    t = np.array([r.t for r in recs])
+    x = np.array([r.y[0] for r in recs])
+    force = np.array([[f.magnitude for f in r.fingers] for r in recs])
+    names = [f.name for f in run.setup.grasper.fingers]
+    fig = Figure(figsize=(13, 4.4))
+    axes = fig.subplots(1, 2)
+    for j, name in enumerate(names):
+        if force[:, j].max() <= 0:
+            continue
+        for ax, abscissa in zip(axes, (t, x * MM)):
+            ax.plot(abscissa, force[:, j], color=COLOURS[j % len(COLOURS)], label=f"finger {name}")
+    for ax, label in zip(axes, ("t (s)", "bird centre X (mm)")):
+        if cap is not None:
+            ax.axhline(cap, color="r", ls="--", label=f"cap {cap:.1f} N")
+        ax.set_xlabel(label)
+        ax.set_ylabel("contact force on the bird (N)")
+        ax.grid(alpha=0.3)
+    _shade(axes[0], run.summary["hold_windows"])
+    axes[0].legend(fontsize=8)
+    return fig
+
+
+def contact_loci_figure(run: GraspRun) -> Figure:
+    """Where each finger touched the bird, on its surface (body frame), in
+    side (x-z) and top (x-y) projections, coloured by force: where bruises
+    would be."""
+    b = run.setup.bird
+    fig = Figure(figsize=(13, 4.6))
+    axes = fig.subplots(1, 2)
+    for ax, (i, j), (w, h), title in zip(axes, [(0, 2), (0, 1)],
+                                         [(b.eta, b.gamma), (b.eta, b.lam)],
+                                         ["side (body x-z)", "top (body x-y)"]):
+        ax.add_patch(EllipsePatch((0, 0), 2 * w * MM, 2 * h * MM, fill=False, color="k"))
+        ax.set_title(title)
+        ax.set_xlabel(f"body {'xyz'[i]} (mm)")
+        ax.set_ylabel(f"body {'xyz'[j]} (mm)")
+        ax.set_aspect("equal")
+        ax.grid(alpha=0.3)
+    points, forces, fingers = [], [], []
+    for r in run.trajectory.records:
+        for k, f in enumerate(r.fingers):
+            if f.body_point is not None and f.magnitude > 0:
+                points.append(f.body_point)
+                forces.append(f.magnitude)
+                fingers.append(k)
+    if points:
+        p = np.array(points) * MM
+        vmax = max(forces)
+        for ax, (i, j) in zip(axes, [(0, 2), (0, 1)]):
+            sc = ax.scatter(p[:, i], p[:, j], c=forces, s=8, cmap="inferno_r", vmin=0,
+                            vmax=vmax)
+            if j == 1:          # the left drum's contacts mirror the right's across y
+                ax.scatter(p[:, i], -p[:, j], c=forces, s=8, cmap="inferno_r", vmin=0,
+                           vmax=vmax, marker="x")
+        fig.colorbar(sc, ax=axes, label="contact force (N)")
+    return fig
+

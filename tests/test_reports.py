@@ -1,0 +1,207 @@
+"""report.html for every kind of run: every promised section and figure is
+there, every figure is an embedded, non-empty PNG, and the tables say what
+result.json says."""
+
+from __future__ import annotations
+
+import base64
+import json
+from dataclasses import replace
+from html.parser import HTMLParser
+from pathlib import Path
+
+import pytest
+
+from design.cli import main
+from design.io.grasp_scene import GraspSettings
+from design.io.scene_writer import grasp_spec, scene_yaml
+from design.report import write_run
+from design.report.design import design_page
+from design.report.page import write_report
+from design.run import RunOutput
+from design.solve.grasp.simulation import simulate_grasp
+from tests.design_cases import short_setup
+
+PROBLEMS = Path(__file__).parent.parent / "problems"
+PNG = b"\x89PNG\r\n\x1a\n"
+
+
+class Report(HTMLParser):
+    """The parts of a report the tests look at: section ids, figures (id ->
+    PNG bytes), tables (id -> rows of cell text) and the banner."""
+
+    def __init__(self, text: str):
+        super().__init__()
+        self.sections, self.figures, self.tables, self.banner = [], {}, {}, None
+        self._figure = self._table = self._row = self._cell = self._banner = None
+        self.feed(text)
+
+    def handle_starttag(self, tag, attrs):
+        a = dict(attrs)
+        if tag == "h2":
+            self.sections.append(a.get("id"))
+        elif tag == "figure":
+            self._figure = a["id"]
+        elif tag == "img" and self._figure:
+            head, data = a["src"].split(",", 1)
+            assert head == "data:image/png;base64"
+            self.figures[self._figure] = base64.b64decode(data)
+        elif tag == "table":
+            self._table = a.get("id", f"table-{len(self.tables)}")
+            self.tables[self._table] = []
+        elif tag == "tr" and self._table:
+            self._row = []
+        elif tag in ("td", "th") and self._row is not None:
+            self._cell = ""
+        elif tag == "div" and "banner" in a.get("class", ""):
+            self._banner, self.banner = a["class"], ""
+
+    def handle_endtag(self, tag):
+        if tag == "figure":
+            self._figure = None
+        elif tag == "table":
+            self._table = None
+        elif tag == "tr" and self._row is not None:
+            self.tables[self._table].append(self._row)
+            self._row = None
+        elif tag in ("td", "th") and self._cell is not None:
+            self._row.append(self._cell)
+            self._cell = None
+        elif tag == "div" and self._banner:
+            self._banner = None
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell += data
+        if self._banner is not None:
+            self.banner += data
+
+    def column(self, table: str, name: str) -> list[str]:
+        head, *rows = self.tables[table]
+        return [r[head.index(name)] for r in rows]
+
+
+def read(out: Path) -> Report:
+    report = Report((out / "report.html").read_text(encoding="utf-8"))
+    for name, png in report.figures.items():
+        assert png.startswith(PNG) and len(png) > 5000, name       # a real picture
+        assert (out / "figures" / f"{name.removeprefix('fig-')}.png").read_bytes() == png
+    return report
+
+
+def close(cell: str, value: float, digits: int = 4) -> bool:
+    """A table cell rounded to ``digits`` significant figures matches value."""
+    return float(cell) == pytest.approx(value, rel=10 ** (1 - digits), abs=1e-12)
+
+
+def test_beam_report(tmp_path):
+    assert main(["simulate", str(PROBLEMS / "beam_table_2_3.yaml"), "--out", str(tmp_path),
+                 "--quiet"]) == 0
+    r, result = read(tmp_path), json.loads((tmp_path / "result.json").read_text())
+    assert r.sections == ["scene", "deflection", "reproduce"]
+    assert list(r.figures) == ["fig-deflection"]
+    assert r.banner == "All 1 loads converged"
+    tip_y = r.column("cases-table", "tip y (m)")
+    assert len(tip_y) == len(result["cases"])
+    assert all(close(c, case["tip"]["y"], 6) for c, case in zip(tip_y, result["cases"]))
+
+
+def test_contact_report(tmp_path):
+    assert main(["simulate", str(PROBLEMS / "contact_pass.yaml"), "--out", str(tmp_path),
+                 "--quiet"]) == 0
+    r, result = read(tmp_path), json.loads((tmp_path / "result.json").read_text())
+    assert r.sections == ["scene", "forces", "reproduce"] and list(r.figures) == ["fig-contact"]
+    forces = r.column("cases-table", "force (N)")
+    assert all(close(c, case["force"]) for c, case in zip(forces, result["cases"]))
+    assert r.banner.startswith(f"All {len(result['cases'])} poses converged")
+
+
+GRASP_SECTIONS = ["layout", "path", "normal-force", "finger-forces", "contact-loci"]
+GRASP_FIGURES = ["fig-layout", "fig-path", "fig-normal_force", "fig-finger_forces",
+                 "fig-contact_loci"]
+
+
+def short_scene(tmp_path) -> Path:
+    path = tmp_path / "short.yaml"
+    path.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(contact_nodes=6),
+                                          "short", "the short grasp")))
+    return path
+
+
+def test_grasp_report(tmp_path):
+    assert main(["simulate", str(short_scene(tmp_path)), "--out", str(tmp_path / "out"),
+                 "--quiet"]) == 0
+    out = tmp_path / "out"
+    r, result = read(out), json.loads((out / "result.json").read_text())
+    assert r.sections == ["scene", "summary", *GRASP_SECTIONS, "reproduce"]
+    assert list(r.figures) == GRASP_FIGURES
+    s = result["summary"]
+    rows = dict(zip(r.column("summary-table", "quantity"), r.column("summary-table", "value")))
+    assert close(rows["longest N = 0 hold"], s["hold_time_s"])
+    assert close(rows["peak finger force"], s["max_finger_force_N"])
+    assert rows["finger with the peak"] == s["max_finger_force_finger"]
+
+
+@pytest.fixture(scope="module")
+def design_run(tmp_path_factory):
+    """One short design solve (one outer iteration) written with its report."""
+    tmp = tmp_path_factory.mktemp("design")
+    problem = {"kind": "design", "name": "short_design", "description": "A short test.",
+               "scene": str(short_scene(tmp)), "cap": "baseline",
+               "variables": {"groups.upper.stiffness_scale": [0.5, 1.5]},
+               "solver": {"time_step": 0.01, "max_iter": 15, "outer_iterations": 1}}
+    path = tmp / "problem.yaml"
+    path.write_text(json.dumps(problem))
+    status = main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
+    return status, tmp / "out"
+
+
+def test_design_report_has_every_section_and_matches_result(design_run):
+    status, out = design_run
+    r, result = read(out), json.loads((out / "result.json").read_text())
+    assert r.sections == ["problem", "verification", *GRASP_SECTIONS, "convergence", "reproduce"]
+    assert list(r.figures) == GRASP_FIGURES + ["fig-convergence"]
+    passed = result["verification"]["passed"]
+    assert (status == 0) == passed
+    assert r.banner.startswith("VERIFIED" if passed else "FAILED")
+    names = r.column("variables-table", "variable")
+    assert names == [v["name"] for v in result["variables"]]
+    for column, key in [("lower", "lower"), ("upper", "upper"), ("baseline", "baseline"),
+                        ("optimum", "optimum")]:
+        cells = r.column("variables-table", column)
+        assert all(close(c, v[key]) for c, v in zip(cells, result["variables"]))
+    v = result["verification"]
+    checks = r.column("verification-table", "independent simulation")
+    assert close(checks[0], v["hold_time_s"]) and close(checks[1], v["max_finger_force_N"])
+    optimiser = r.column("verification-table", "optimiser")
+    assert close(optimiser[0], v["optimiser_hold_time_s"])
+    assert len(r.tables["history-table"]) - 1 == len(result["solver"]["history"])
+
+
+def test_design_report_draws_the_pareto_curve(design_run, tmp_path):
+    """With a Pareto study the report adds its table and curve (the study's
+    rows here are made up; the page only draws them)."""
+    _, out = design_run
+    result = json.loads((out / "result.json").read_text())
+    result["pareto"] = [{"cap_N": c, "status": "verified", "optimiser_hold_time_s": h,
+                         "verified_hold_time_s": h, "verified_max_finger_force_N": c - 1,
+                         "passed": True} for c, h in [(10.0, 0.1), (12.0, 0.2)]]
+    run = simulate_grasp(replace(short_setup(), duration=0.3))
+    write_report(tmp_path, design_page(result, run, run))
+    r = read(tmp_path)
+    assert "pareto" in r.sections and "fig-pareto" in r.figures
+    assert [float(c) for c in r.column("pareto-table", "cap_N")] == [10.0, 12.0]
+
+
+def test_a_report_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
+    """An error while the report is being built leaves nothing behind: the
+    page is rendered in memory before any file is written."""
+    output = RunOutput({"kind": "beam", "name": "x"})
+
+    def broken(result):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr("design.report.beam_contact.beam_page", broken)
+    with pytest.raises(KeyboardInterrupt):
+        write_run(tmp_path / "out", output)
+    assert not (tmp_path / "out").exists()
