@@ -5,6 +5,7 @@ verification that must catch a design breaking the cap."""
 import json
 
 import numpy as np
+import pytest
 
 from design.cli import main
 from design.io.grasp_scene import GraspSettings
@@ -115,3 +116,20 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
     assert result["status"] == "infeasible" and not result["verification"]["passed"]
     assert result["verification"]["max_finger_force_N"] > result["verification"]["cap_N"]
     assert (tmp_path / "out" / "optimum.yaml").exists()
+
+
+def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch):
+    """Continuation in the cap: the NLP of outer iteration k sees the cap
+    times 1 - margin / 2^k (here every NLP fails, so the loop only records
+    the caps it asked for while its trust region shrinks to nothing)."""
+    asked = []
+
+    def no_nlp(space, schedule, run, cap, *args, **kwargs):
+        asked.append(cap)
+        raise RuntimeError("no NLP in this test")
+
+    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", no_nlp)
+    out = optimise(stiffness_space("upper"), 20.0, LoopSettings(nlp=SETTINGS.nlp, cap_margin=0.2))
+    assert asked == pytest.approx([16.0, 18.0, 19.0, 19.5])
+    assert [i["error"] for i in out.iterations] == ["no NLP in this test"] * 4
+    assert out.best is out.baseline

@@ -13,7 +13,7 @@ bounds, the bruise cap, the design rules and the solver settings.
     cap: baseline              # N | baseline | {relative_to_baseline: 0.75} | a list: Pareto study
     rules: {sigma_lambda: 0.01, bird_spacing: 0.3, finger_sets: 1}
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
-             trust_region: 0.15, ipopt: {}}
+             trust_region: 0.15, cap_margin: 0.25, ipopt: {}}
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
@@ -197,7 +197,7 @@ def _rules(reader: Reader, value: object) -> Rules | None:
 def _settings(reader: Reader, value: object) -> LoopSettings | None:
     spec = reader.mapping(value, "solver", optional=(
         "time_step", "beam_intervals", "max_iter", "tolerance", "outer_iterations",
-        "trust_region", "ipopt"))
+        "trust_region", "cap_margin", "ipopt"))
     if spec is None:
         return None
     d, n = LoopSettings(), NLPSettings()
@@ -212,11 +212,13 @@ def _settings(reader: Reader, value: object) -> LoopSettings | None:
                            default=d.outer_iterations)
     radius = reader.quantity(spec, "trust_region", "solver", "dimensionless", lo=0.0,
                              lo_open=True, hi=1.0, default=d.radius)
+    margin = reader.quantity(spec, "cap_margin", "solver", "dimensionless", lo=0.0, hi=0.9,
+                             default=d.cap_margin)
     ipopt = spec.get("ipopt", {})
     if not isinstance(ipopt, Mapping):
         reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")
         return None
-    if None in (step, beam, iters, tol, outer, radius):
+    if None in (step, beam, iters, tol, outer, radius, margin):
         return None
     nlp = NLPSettings(step, beam, n.degree, iters, tol, dict(ipopt))
-    return LoopSettings(nlp, outer, radius, d.min_radius, d.simulator, beam)
+    return LoopSettings(nlp, outer, radius, d.min_radius, d.simulator, beam, margin)

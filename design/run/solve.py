@@ -146,6 +146,7 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
                          "max_iter": problem.settings.nlp.max_iter,
                          "outer_iterations": problem.settings.outer_iterations,
                          "trust_region": problem.settings.radius,
+                         "cap_margin": problem.settings.cap_margin,
                          "ipopt": problem.settings.nlp.ipopt},
         },
     }
