@@ -28,6 +28,8 @@ from design.io.results import jsonable
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import ExponentialI, UniformEI
 from design.solve.beam import METHODS, solve_beam
+from design.tradeoff.beam import RESOLUTIONS, reference, tips
+from design.tradeoff.study import timed
 
 RESULTS = Path(__file__).parent / "results" / "beam.json"
 THESIS = ExponentialI(4.8e6, 7.3e-8, -3.6551e-8, 3.2102e-9, -70.87, -141.73)
@@ -35,37 +37,7 @@ CASES = {
     "table_2_1": (Finger(0.203, UniformEI(0.08)), PointLoad(15.0, np.pi / 2, 0.1016)),
     "table_2_3": (Finger(0.203, THESIS), PointLoad(15.0, np.pi / 2, 0.0762)),
 }
-RESOLUTIONS = {
-    "small-deflection": [None],
-    "frisch-fay": [None],
-    "shooting": [64, 256, 1024],
-    "fdm": [99, 399, 1599],
-    "collocation": [4, 8, 16, 32],
-}
 BVP_TOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
-
-
-def reference(finger: Finger, loads: list[PointLoad]) -> np.ndarray:
-    """Load points (n, 2) of the high-accuracy reference."""
-    if finger.stiffness.uniform:
-        sols = solve_beam(finger, loads, "frisch-fay")
-    else:
-        sols = solve_beam(finger, loads, "collocation", nodes=128)
-    return np.array([[s.x[-1], s.y[-1]] for s in sols])
-
-
-def tips(sols) -> np.ndarray:
-    return np.array([[s.x[-1], s.y[-1]] for s in sols])
-
-
-def timed(fn, repeat: int) -> tuple[object, float]:
-    """Result and best wall time (s) of ``repeat`` calls."""
-    best, out = np.inf, None
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        best = min(best, time.perf_counter() - t0)
-    return out, best
 
 
 def bvp_sweep(finger: Finger, loads: list[PointLoad], tol: float) -> np.ndarray:
@@ -103,7 +75,7 @@ def run(quick: bool) -> dict:
             if METHODS[method](finger).check():
                 continue
             for nodes in resolutions:
-                sols, dt = timed(lambda: solve_beam(finger, [load], method, nodes=nodes), repeat)
+                sols, dt, _ = timed(lambda: solve_beam(finger, [load], method, nodes=nodes), repeat)
                 err = float(np.linalg.norm(tips(sols)[0] - ref))
                 rows.append({"case": case, "method": method,
                              "resolution": nodes or METHODS[method].default_nodes,
@@ -111,7 +83,7 @@ def run(quick: bool) -> dict:
                              "tip_error_m": err, "error_estimate_m": sols[0].error_estimate,
                              "time_per_solve_s": dt})
         for tol in BVP_TOLS:
-            got, dt = timed(lambda: bvp_sweep(finger, [load], tol), repeat)
+            got, dt, _ = timed(lambda: bvp_sweep(finger, [load], tol), repeat)
             rows.append({"case": case, "method": "scipy solve_bvp", "resolution": f"tol={tol:g}",
                          "default": False, "tip_error_m": float(np.linalg.norm(got[0] - ref)),
                          "error_estimate_m": None, "time_per_solve_s": dt})
@@ -149,7 +121,7 @@ def run(quick: bool) -> dict:
     ff_loads = [PointLoad(f, np.pi / 2, 0.1016) for f in np.linspace(0.1, 30.0, 1000)]
     ff_timing = {}
     for nodes in [2, 21, 41, 101]:
-        _, dt = timed(lambda: solve_beam(uni, ff_loads, "frisch-fay", nodes=nodes), repeat)
+        _, dt, _ = timed(lambda: solve_beam(uni, ff_loads, "frisch-fay", nodes=nodes), repeat)
         ff_timing[f"shape_points_{nodes}"] = dt / len(ff_loads)
 
     # ratios to solve_bvp at equal accuracy: solve_bvp's time interpolated

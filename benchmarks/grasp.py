@@ -22,39 +22,22 @@ from pathlib import Path
 from design.io.results import jsonable
 from design.reproduce.grasp import thesis_setup
 from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.tradeoff.grasp import CASES, DEFAULT, simulate
 
 RESULTS = Path(__file__).parent / "results" / "grasp.json"
 T_SKIP, DURATION = 0.55, 1.0
-DEFAULT = IntegratorSettings()
-CASES = [
-    ("adaptive rk45 (default)", DEFAULT),
-    ("adaptive rk45, max step 10 ms", IntegratorSettings(max_step=1e-2)),
-    ("adaptive rk45, max step 2.5 ms", IntegratorSettings(max_step=2.5e-3)),
-    ("adaptive rk45, rtol 1e-4", IntegratorSettings(rtol=1e-4, atol=1e-6)),
-    ("adaptive dop853", IntegratorSettings(stepper="dop853")),
-    ("bdf4 (thesis) 16.6 ms", IntegratorSettings(integrator="bdf4", step=16.6e-3)),
-    ("bdf4 (thesis) 5.6 ms", IntegratorSettings(integrator="bdf4", step=5.6e-3)),
-    ("bdf4 1.4 ms", IntegratorSettings(integrator="bdf4", step=1.4e-3)),
-]
 
 
 def measure(settings: IntegratorSettings, reach_filter: bool = True, t_skip: float = T_SKIP,
             duration: float = DURATION) -> dict:
-    run = simulate_grasp(thesis_setup(t_skip, duration), settings, reach_filter=reach_filter)
-    s = run.summary
-    wall = run.trajectory.wall_time + run.setup_time
-    return {"wall_s": wall, "wall_per_simulated_s": wall / duration,
-            "hold_time_s": s["hold_time_s"], "max_finger_force_N": s["max_finger_force_N"],
-            "max_finger_force_finger": s["max_finger_force_finger"],
-            "steps": run.trajectory.steps, "contact_solves": run.contact_solves,
-            "skipped_finger_evaluations": run.skipped, "ok": run.trajectory.ok}
+    m = simulate(thesis_setup(t_skip, duration), settings, reach_filter=reach_filter)
+    return {**m, "wall_per_simulated_s": m["wall_s"] / duration}
 
 
 def main() -> None:
     ref = measure(DEFAULT.finer(4))
     rows = []
-    for name, settings in CASES:
+    for name, settings in CASES.items():
         m = measure(settings)
         m["integrator"] = name
         m["hold_time_error_pct"] = 100 * (m["hold_time_s"] / ref["hold_time_s"] - 1)

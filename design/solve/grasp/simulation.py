@@ -47,18 +47,7 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     """Integrate the symmetric grasp from the bird sitting on the belt at start_x."""
     t0 = time.perf_counter()
     b, conv = setup.bird, setup.conveyor
-    windows = None
-    if reach_filter:
-        # the belt carries the bird: its centre follows X0 + v t within the margin
-        path = lambda t: (setup.start_x + conv.speed * t, b.gamma)  # noqa: E731
-        if conv.decelerates:
-            path = lambda t: (setup.start_x + conv.final_speed * t, b.gamma)  # noqa: E731
-            windows_fast = reach_windows(setup.grasper, b, setup.drum_speed,
-                                         lambda t: (setup.start_x + conv.speed * t, b.gamma),
-                                         setup.duration)
-        windows = reach_windows(setup.grasper, b, setup.drum_speed, path, setup.duration)
-        if conv.decelerates:                       # a band covering both belt speeds
-            windows = [_union(w1, w2) for w1, w2 in zip(windows, windows_fast)]
+    windows = setup_reach_windows(setup) if reach_filter else None
     fingers = FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction, windows,
                            intervals=contact_nodes)
     dyn = BirdDynamics(b, setup.legs, setup.conveyor_friction)
@@ -67,6 +56,23 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     setup_time = time.perf_counter() - t0
     traj = integrate(grasp, y0, setup.duration, integrator, progress)
     return GraspRun(setup, traj, windows, fingers.solves, fingers.skipped, setup_time)
+
+
+def setup_reach_windows(setup: GraspSetup) -> list[list[tuple[float, float]]]:
+    """Per finger, the time windows (s) in which it can touch the bird (see
+    :func:`~design.solve.grasp.fingers.reach_windows`): the belt carries the
+    bird, its centre following X0 + v t; a decelerating belt gives a band
+    covering both of its speeds."""
+    b, conv = setup.bird, setup.conveyor
+
+    def windows_at(speed: float):
+        return reach_windows(setup.grasper, b, setup.drum_speed,
+                             lambda t: (setup.start_x + speed * t, b.gamma), setup.duration)
+
+    if not conv.decelerates:
+        return windows_at(conv.speed)
+    return [_union(w1, w2) for w1, w2 in zip(windows_at(conv.final_speed),
+                                             windows_at(conv.speed))]
 
 
 def _union(a, b):
