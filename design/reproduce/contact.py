@@ -10,8 +10,6 @@ inconsistent in itself, and with 82.5 mm our contact points match Table
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from design.physics.beam import Finger, PointLoad
@@ -62,22 +60,6 @@ def scene(phi_deg: float, center: tuple[float, float]) -> tuple[FingerPose, Elli
     return FingerPose(DRUM_RADIUS, np.radians(phi_deg)), Ellipse(0.099, 0.067, center)
 
 
-@dataclass(frozen=True)
-class Row:
-    """One compared quantity: ours and the thesis's, with a note."""
-
-    item: str
-    ours: float | str
-    thesis: float | str
-    note: str = ""
-
-    @property
-    def difference(self) -> str:
-        if isinstance(self.ours, float) and isinstance(self.thesis, float) and self.thesis:
-            return f"{100 * (self.ours - self.thesis) / abs(self.thesis):+.1f}%"
-        return "-"
-
-
 def _describe(sol: ContactSolution) -> str:
     return (f"({sol.point[0]:.4f}, {sol.point[1]:.4f}) m, F = {sol.force:.3f} N, "
             f"ψ0 = {np.degrees(sol.psi):.2f}°, L = {1e3 * sol.arc_length:.1f} mm")
@@ -115,6 +97,28 @@ def thesis_pass(sliding: str = "push", step_deg: float = 6.0, friction: float = 
     return dict(zip(phis, sols))
 
 
+def fine_passes(step_deg: float = 1.0) -> dict[str, dict[float, ContactSolution]]:
+    """The pass at ``step_deg`` (deg) steps with the thesis's friction convention
+    (``push``) and with friction from the sliding velocity (``auto``)."""
+    return {"push": thesis_pass("push", step_deg), "auto": thesis_pass("auto", step_deg)}
+
+
+def fem_pass(fine: dict[str, dict[float, ContactSolution]] | None = None
+             ) -> dict[float, tuple[float, ContactSolution, ContactSolution]]:
+    """Table 3-6's poses: ellipse X (m) -> (φ in deg, ours push, ours auto
+    friction), taken from the 1° passes ``fine`` (every Table 3-6 pose is a
+    whole degree)."""
+    fine = fine or fine_passes()
+    return {x: (pass_angle(x), fine["push"][float(round(pass_angle(x)))],
+                fine["auto"][float(round(pass_angle(x)))]) for x in FEM_PASS}
+
+
+def force_ratios(push: dict[float, ContactSolution]) -> list[float]:
+    """Table 3-5's force over ours (push) at each listed φ where ours touches."""
+    return [THESIS_PASS[k][2] / push[float(k)].force for k in THESIS_PASS
+            if push[float(k)].contact]
+
+
 def markdown() -> str:
     """The reproduction report for chapter III."""
     lines = ["# Contact model reproduced (thesis chapter III)", "",
@@ -147,7 +151,7 @@ def markdown() -> str:
         ours_pt = f"({p.point[0]:.4f}, {p.point[1]:.4f})" if p.contact else "no contact"
         lines.append(f"| {phi} | {pass_position(phi):.4f} | ({pt[0]}, {pt[1]}) | {ours_pt} | "
                      f"{force} | {p.force:.3f} | {a.force:.3f} | {a.friction} |")
-    ratio = [THESIS_PASS[k][2] / push[float(k)].force for k in THESIS_PASS if push[float(k)].contact]
+    ratio = force_ratios(push)
     lines += ["", f"Ours (push, the thesis's convention) is {100 * (1 - 1 / np.mean(ratio)):.1f}% "
               f"below the thesis's forces at every pose (ratio {min(ratio):.3f}-{max(ratio):.3f}) "
               "with the same contact points: the force scales with EI at fixed geometry, so the "
@@ -157,16 +161,13 @@ def markdown() -> str:
               "## Table 3-6: finite-element forces", "",
               "| X (m) | φ (°) | FEM F (N) | ours, push (N) | ours, auto friction (N) |",
               "|---|---|---|---|---|"]
-    for x, f in FEM_PASS.items():
-        phi = pass_angle(x)
-        pose, ell = scene(phi, (x, 0.184))
-        p = RobustContact(UNIFORM, 0.6041).solve(pose, ell, "push")
-        a = RobustContact(UNIFORM, 0.6041).solve(pose, ell, "auto", Motion(OMEGA, (SPEED, 0.0)))
-        lines.append(f"| {x} | {phi:.1f} | {f} | {p.force:.3f} | {a.force:.3f} |")
-    fine_push, fine_auto = thesis_pass("push", 1.0), thesis_pass("auto", 1.0)
+    fine = fine_passes()
+    for x, (phi, p, a) in fem_pass(fine).items():
+        lines.append(f"| {x} | {phi:.1f} | {FEM_PASS[x]} | {p.force:.3f} | {a.force:.3f} |")
+    peak = {k: max(s.force for s in sols.values()) for k, sols in fine.items()}
     lines += ["", f"Peak force over the pass (1° steps): FEM 31.8 N (Table 3-6); thesis analytic "
-              f"≈ 23 N (Figure 3-17); ours {max(s.force for s in fine_push.values()):.1f} N with "
-              f"the thesis's friction convention, {max(s.force for s in fine_auto.values()):.1f} N "
+              f"≈ 23 N (Figure 3-17); ours {peak['push']:.1f} N with "
+              f"the thesis's friction convention, {peak['auto']:.1f} N "
               "with the friction direction taken from the sliding velocity. In the loading half "
               "of the pass the finger slides tipwards over the object, so friction on it points "
               "to its base, opposite to the thesis's fixed convention; that is what lifts the "

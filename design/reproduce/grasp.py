@@ -16,11 +16,12 @@ from design.solve.grasp.simulation import GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
 OMEGA = 20 * 2 * np.pi / 60
-#: Table 5-3 (mean bird) and 5-4 (football) starts, m
-MEAN_START, FOOTBALL_START = -0.457, -0.305
+#: Table 5-3 (mean bird), 5-4 (football) and 5-5 (bird sizes) starts, m
+MEAN_START, FOOTBALL_START, SIZES_START = -0.457, -0.305, -0.381
 
 
-def _load(kind_reader, *path):
+def load_model(kind_reader, *path):
+    """A shipped model (finger, grasper, bird, conveyor) from models/<path>."""
     r = Reader("models")
     model = kind_reader(r, str(MODELS.joinpath(*path)), "", MODELS)
     r.raise_if_any()
@@ -29,7 +30,7 @@ def _load(kind_reader, *path):
 
 def with_lower(grasper, finger_file: str):
     """The grasper with every lower finger in another finger model's stiffness."""
-    model = _load(read_finger, "fingers", finger_file)
+    model = load_model(read_finger, "fingers", finger_file)
     return replace(grasper, fingers=tuple(
         replace(f, finger=Finger(f.finger.length, model.stiffness, model.name))
         if f.group == "lower" else f for f in grasper.fingers))
@@ -50,11 +51,11 @@ def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard"
     started ``t_skip`` seconds in: fingers advanced by ω t_skip and the bird by
     v t_skip, so that a short run covers the grasp itself (valid while nothing
     touches before t_skip)."""
-    grasper = _load(read_grasper, "graspers", "thesis_table_5_1.yaml")
+    grasper = load_model(read_grasper, "graspers", "thesis_table_5_1.yaml")
     if lower == "soft":
         grasper = with_lower(grasper, "thesis_nonuniform_soft.yaml")
-    bird = _load(read_bird, "birds", bird_file)
-    conveyor = _load(read_conveyor, "conveyors", conveyor_file)
+    bird = load_model(read_bird, "birds", bird_file)
+    conveyor = load_model(read_conveyor, "conveyors", conveyor_file)
     return GraspSetup(advanced(grasper, t_skip), bird, conveyor, OMEGA,
                       start + conveyor.speed * t_skip, friction, friction, legs, duration)
 
@@ -69,22 +70,44 @@ def _line(name: str, run, belt_end: float | None = None) -> str:
             f"{x_end:+.3f} |")
 
 
-def scenarios() -> dict:
-    """The chapter V runs, by name (GraspRun each)."""
-    from design.solve.grasp.simulation import simulate_grasp
+def football_setup(start: float = FOOTBALL_START) -> GraspSetup:
+    """The Table 5-4 football (µ = 1.16) on the Figure 5-10 decelerating belt,
+    started at ``start`` (m)."""
+    return thesis_setup(0.0, 2.0, "hard", "football.yaml", start, "decelerate_figure_5_10.yaml",
+                        1.16)
 
-    fb = thesis_setup(0.0, 2.0, "hard", "football.yaml", FOOTBALL_START,
-                      "decelerate_figure_5_10.yaml", 1.16)
-    runs = {
-        "mean bird, hard lower fingers": simulate_grasp(thesis_setup(0.0, 2.0, "hard")),
-        "mean bird, soft lower fingers": simulate_grasp(thesis_setup(0.0, 2.0, "soft")),
-        "football, µ = 1.16": simulate_grasp(fb),
-        "football, finger µ = 0": simulate_grasp(replace(fb, finger_friction=0.0)),
+
+def scenario_setups() -> dict[str, GraspSetup]:
+    """The chapter V runs' setups, by name."""
+    fb = football_setup()
+    setups = {
+        "mean bird, hard lower fingers": thesis_setup(0.0, 2.0, "hard"),
+        "mean bird, soft lower fingers": thesis_setup(0.0, 2.0, "soft"),
+        "football, µ = 1.16": fb,
+        "football, finger µ = 0": replace(fb, finger_friction=0.0),
     }
     for bird in ["small_1_20kg", "mean_1_66kg", "mean_1_80kg", "large_2_05kg", "large_2_30kg"]:
-        runs[f"Table 5-5: {bird}"] = simulate_grasp(
-            thesis_setup(0.0, 2.0, "hard", f"{bird}.yaml", -0.381))
+        setups[f"Table 5-5: {bird}"] = thesis_setup(0.0, 2.0, "hard", f"{bird}.yaml",
+                                                    SIZES_START)
+    return setups
+
+
+def simulate_all(setups: dict[str, GraspSetup], progress=None) -> dict:
+    """Each setup simulated (GraspRun each, by name); ``progress(message)`` is
+    called before each run."""
+    from design.solve.grasp.simulation import simulate_grasp
+
+    runs = {}
+    for k, (name, setup) in enumerate(setups.items(), 1):
+        if progress:
+            progress(f"grasp run {k}/{len(setups)}: {name}")
+        runs[name] = simulate_grasp(setup)
     return runs
+
+
+def scenarios(progress=None) -> dict:
+    """The chapter V runs, by name (GraspRun each)."""
+    return simulate_all(scenario_setups(), progress)
 
 
 def markdown(runs: dict | None = None) -> str:

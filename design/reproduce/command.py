@@ -1,0 +1,129 @@
+"""``design reproduce``: rerun the thesis's reference cases and write the
+reproduction report (reproduction.json, reproduction.csv, report.html and
+figures/*.png), every row a thesis number or claim against ours.
+
+Exit status: 0 every case computed; 1 a case could not be computed (the
+report is still written, saying which).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from design import __version__
+from design.io.results import csv_text, jsonable, write_atomic
+from design.report.page import Page, write_report
+from design.reproduce import beam_rows, contact_rows, grasp_rows
+from design.reproduce.rows import COLUMNS, Section, tally
+
+HOW_TO_READ = (
+    "Each row sets a number or a claim of the thesis beside ours. A numeric row agrees when "
+    "|ours - thesis| <= tolerance (in its unit); the tolerance is half a unit in the thesis's "
+    "last printed digit, widened only where the thesis states a coarser accuracy (e.g. its "
+    "contact solver's ERR = 0.5 mm), where its number is a reading of a plot, or where it "
+    "depends on inputs it gives roughly or not at all; each section says which. A claim row (a "
+    "trend "
+    "or a bound) agrees when ours bears it out by the criterion in its explanation. SI units: "
+    "m, N, s, rad, N m^2 (the thesis's degrees converted). Disagreements are findings, not "
+    "failures: their explanations say what we think causes them.")
+
+
+def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
+    """(name, function of the progress callback returning the sections)."""
+    chapters = [
+        ("chapter II: Tables 2-1, 2-3 and 5-2",
+         lambda progress: beam_rows.sections(beam_rows.compute())),
+        ("chapter III: Tables 3-2, 3-3, 3-5 and 3-6",
+         lambda progress: contact_rows.sections(contact_rows.compute())),
+    ]
+    if not quick:
+        chapters.append(("chapter V: grasp figures (14 runs, a minute or two)",
+                         lambda progress: grasp_rows.sections(grasp_rows.compute(progress))))
+    return chapters
+
+
+def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[str]]:
+    """Every section that could be computed, and a message per chapter that could not."""
+    sections, failures = [], []
+    for name, build in _chapters(quick):
+        t0 = time.perf_counter()
+        if progress:
+            progress(f"{name} ...")
+        try:
+            sections += build(progress)
+        except Exception as exc:  # noqa: BLE001  (any solver error: report it, go on)
+            failures.append(f"{name}: could not be computed: {type(exc).__name__}: {exc}")
+        if progress:
+            progress(f"{name}: {time.perf_counter() - t0:.1f} s")
+    if quick:
+        sections.append(Section("grasp", grasp_rows.TITLE, "Skipped (--quick): the grasp runs "
+                                "take a minute or two; run 'design reproduce' without --quick.",
+                                []))
+    return sections, failures
+
+
+def build_page(sections: list[Section], failures: list[str], quick: bool,
+               started: float) -> tuple[Page, float]:
+    """The report (verdict banner, summary, one part per section, the run)
+    and the wall time (s) since ``started`` (a time.perf_counter() value)."""
+    rows = [r for s in sections for r in s.rows]
+    agree, total = tally(rows)
+    page = Page("Thesis reproduction: ours against the thesis's numbers")
+    verdict = f"{agree} of {total} rows agree with the thesis within their stated tolerance"
+    if quick:
+        verdict += " (--quick: grasp figures skipped)"
+    if failures:
+        verdict += f"; {len(failures)} chapter(s) could not be computed"
+    page.banner(verdict, "failed" if failures else "passed" if agree == total else "neutral")
+    page.section("Summary", "summary")
+    page.text(HOW_TO_READ)
+    for message in failures:
+        page.text(message)
+    counts = [(s.title, *tally(s.rows)) for s in sections if s.rows]
+    page.table([{"section": t, "rows": n, "agree": k, "disagree": n - k} for t, k, n in counts],
+               table_id="summary-table")
+    for s in sections:
+        page.section(s.title, s.anchor)
+        page.text(s.text)
+        if s.rows:
+            page.table([r.as_dict() for r in s.rows], table_id=f"rows-{s.anchor}", digits=6)
+        for fig, name, caption in s.figures:
+            page.figure(fig, name, caption)
+    wall = time.perf_counter() - started
+    page.section("Run", "run")
+    page.text(f"design reproduce{' --quick' if quick else ''}, toolkit {__version__}, wall time "
+              f"{wall:.1f} s. Data: reproduction.json, reproduction.csv (the same rows).")
+    return page, wall
+
+
+def cmd_reproduce(args: argparse.Namespace) -> int:
+    """Run the reference cases, write the report; print the paths written."""
+    from design.cli import EXIT_FAILED, EXIT_OK, _progress
+
+    t0 = time.perf_counter()
+    progress = None if args.quiet else _progress
+    out = Path(args.out) if args.out else Path("reports") / "reproduction"
+    sections, failures = compute_sections(args.quick, progress)
+    rows = [r for s in sections for r in s.rows]
+    agree, total = tally(rows)
+    page, wall = build_page(sections, failures, args.quick, t0)
+    result = {"kind": "reproduction", "toolkit_version": __version__, "wall_time_s": wall,
+              "quick": args.quick, "skipped": [grasp_rows.TITLE] if args.quick else [],
+              "failures": failures, "agree": agree, "total": total, "columns": list(COLUMNS),
+              "rows": [r.as_dict() for r in rows]}
+    files = {"reproduction.json": json.dumps(jsonable(result), indent=1, allow_nan=False) + "\n",
+             "reproduction.csv": csv_text([r.as_dict() for r in rows])}
+    if progress:
+        progress(f"writing {out}")
+    for name, text in files.items():
+        write_atomic(out / name, text)
+        print(out / name)
+    for path in write_report(out, page):
+        print(path)
+    print(f"{agree} of {total} rows agree with the thesis within their stated tolerance"
+          + (f"; could not compute: {'; '.join(failures)}" if failures else ""))
+    return EXIT_FAILED if failures else EXIT_OK

@@ -1,0 +1,88 @@
+"""One row of the reproduction report: a thesis number or claim against ours.
+
+A numeric row agrees when |ours - thesis| <= tolerance (in the row's unit).
+A claim row (the thesis states a trend, a bound or a reading of a plot)
+agrees when ours bears the claim out, by the criterion its explanation
+states. Every tolerance is fixed before the comparison, from the thesis's
+printed digits, its stated accuracy or the spread of what it did not list.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+#: the columns of reproduction.json / .csv and of the report's tables, in order
+COLUMNS = ("case", "quantity", "unit", "thesis", "ours", "difference", "relative_difference",
+           "tolerance", "agrees", "explanation")
+
+
+class CaseFailed(RuntimeError):
+    """A reference case whose solution did not converge or finish."""
+
+
+@dataclass(frozen=True)
+class Row:
+    """A compared quantity; ``thesis`` and ``ours`` in ``unit`` (SI) or text."""
+
+    case: str
+    quantity: str
+    unit: str
+    thesis: float | str
+    ours: float | str
+    explanation: str = ""
+    tolerance: float | None = None
+    holds: bool | None = None
+
+    @property
+    def numeric(self) -> bool:
+        return isinstance(self.thesis, float) and isinstance(self.ours, float)
+
+    @property
+    def difference(self) -> float | None:
+        """ours - thesis, in ``unit``; None for a claim."""
+        return self.ours - self.thesis if self.numeric else None
+
+    @property
+    def relative_difference(self) -> float | None:
+        """(ours - thesis) / |thesis|; None for a claim or a zero thesis value."""
+        return self.difference / abs(self.thesis) if self.numeric and self.thesis else None
+
+    @property
+    def agrees(self) -> bool:
+        if self.numeric:
+            return math.isfinite(self.ours) and abs(self.difference) <= self.tolerance
+        return bool(self.holds)
+
+    def as_dict(self) -> dict:
+        return {c: getattr(self, c) for c in COLUMNS}
+
+
+def compare(case: str, quantity: str, unit: str, thesis: float, ours: float, tolerance: float,
+            explanation: str = "") -> Row:
+    """A numeric row: agrees when |ours - thesis| <= tolerance (``unit``)."""
+    return Row(case, quantity, unit, float(thesis), float(ours), explanation, float(tolerance))
+
+
+def claim(case: str, quantity: str, thesis: str, ours: float | str, holds: bool,
+          explanation: str, unit: str = "") -> Row:
+    """A claim row: the thesis's statement, our number or finding, and whether it holds."""
+    return Row(case, quantity, unit, thesis, float(ours) if not isinstance(ours, str) else ours,
+               explanation, holds=bool(holds))
+
+
+def tally(rows: list[Row]) -> tuple[int, int]:
+    """(rows that agree, rows)."""
+    return sum(r.agrees for r in rows), len(rows)
+
+
+@dataclass
+class Section:
+    """A part of the report: its rows, a paragraph and figures (matplotlib
+    figure, file name without .png, caption)."""
+
+    anchor: str
+    title: str
+    text: str
+    rows: list[Row]
+    figures: list[tuple[object, str, str]] = field(default_factory=list)
