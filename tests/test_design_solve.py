@@ -116,6 +116,11 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
     assert result["status"] == "infeasible" and not result["verification"]["passed"]
     assert result["verification"]["max_finger_force_N"] > result["verification"]["cap_N"]
     assert (tmp_path / "out" / "optimum.yaml").exists()
+    # the report says so first: its first block after the title is the red banner
+    report = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
+    body = report[report.index("</nav>"):]
+    assert body.index('<div class="banner failed" id="verdict">FAILED (infeasible)') < \
+        body.index("<h2")
 
 
 def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch):
@@ -133,3 +138,23 @@ def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch):
     assert asked == pytest.approx([16.0, 18.0, 19.0, 19.5])
     assert [i["error"] for i in out.iterations] == ["no NLP in this test"] * 4
     assert out.best is out.baseline
+
+
+def test_a_stalled_view_stops_and_a_converging_one_does_not():
+    """The stall rule on made-up violation histories: 15 iterations without
+    a 10 % gain above the floor stop Ipopt; progress, or a violation under
+    the floor, does not."""
+    from types import SimpleNamespace
+
+    from design.solve.optimize.transcription import _Progress
+
+    def stalled(violations, n=15, floor=1e-2):
+        fake = SimpleNamespace(stall=(n, floor), history=[{"violation": v} for v in violations])
+        return _Progress.stalled(fake)
+
+    flat = [1.0, 0.5, 0.1] + [0.095] * 15
+    assert stalled(flat)
+    assert not stalled(flat[:-1])                          # only 14 iterations so far
+    assert not stalled([1.0, 0.5, 0.1] + list(np.geomspace(0.09, 0.02, 15)))   # still gaining
+    assert not stalled([1.0, 0.5, 1e-3] + [1e-3] * 15)    # feasible: the objective may move
+    assert not stalled(flat, n=0)                          # rule off

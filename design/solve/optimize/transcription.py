@@ -60,6 +60,11 @@ class NLPSettings:
     #: wall-clock limit of one Ipopt solve (s): a safety net only, far above a
     #: normal solve, since a binding limit makes results depend on machine load
     max_wall_time: float = 600.0
+    #: stop when the constraint violation is above ``stall_violation`` and the
+    #: last ``stall_iterations`` iterations have not lowered its best value by
+    #: 10 % (0: never); deterministic, unlike a time limit
+    stall_iterations: int = 0
+    stall_violation: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -373,6 +378,7 @@ class _Progress(ca.Callback):
         self.lbg, self.ubg = nlp.lbg, nlp.ubg
         self.history, self.report = history, progress
         self.hold_index = nlp.n_design + nlp.schedule.hold
+        self.stall = nlp.settings.stall_iterations, nlp.settings.stall_violation
         self.streams = sys.stdout, sys.stderr
         self.construct("progress", {})
 
@@ -412,4 +418,9 @@ class _Progress(ca.Callback):
                             f"{hold:.4f} s, constraint violation {violation:.2e}")
             finally:
                 sys.stdout, sys.stderr = muted
-        return [0]
+        return [int(self.stalled())]          # non-zero: Ipopt stops (User_Requested_Stop)
+
+    def stalled(self) -> bool:
+        n, floor = self.stall
+        v = [h["violation"] for h in self.history]
+        return bool(n) and len(v) > n and v[-1] > floor and min(v[-n:]) > 0.9 * min(v[:-n])
