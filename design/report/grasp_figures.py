@@ -205,7 +205,8 @@ def finger_force_figure(run: GraspRun, cap: float | None = None) -> Figure:
         ax.set_ylabel("contact force on the bird (N)")
         ax.grid(alpha=0.3)
     _shade(axes[0], run.summary["hold_windows"])
-    axes[0].legend(fontsize=8)
+    if axes[0].get_legend_handles_labels()[0]:        # nothing to list when nothing touched
+        axes[0].legend(fontsize=8)
     return fig
 
 
