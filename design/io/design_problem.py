@@ -31,7 +31,7 @@ from design.io.files import resolve
 from design.io.grasp_scene import GraspScene
 from design.io.reader import Reader, did_you_mean, join
 from design.solve.optimize.transcription import NLPSettings, Rules
-from design.solve.optimize.trust_region import LoopSettings
+from design.solve.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
 from design.solve.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
                                              GROUP_FIELDS)
 
@@ -88,8 +88,11 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     settings = _settings(reader, data.get("solver", {}))
     if not reader.ok or None in (scene, variables, caps, rules, settings):
         return None
-    # the loop's simulations use the scene's integrator, with the NLP's finger mesh
-    settings = replace(settings, simulator=scene.settings.integrator)
+    # the loop's simulations use the scene's integrator, no looser than the
+    # loop's own tolerances (trust_region.LOOP_SIMULATOR), with the NLP's finger mesh
+    given, tight = scene.settings.integrator, LOOP_SIMULATOR
+    settings = replace(settings, simulator=replace(
+        given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol)))
     return DesignProblem(name, scene, variables, caps, rules, settings,
                          data.get("description", ""))
 

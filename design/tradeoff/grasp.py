@@ -27,7 +27,7 @@ CASES = {
     "adaptive rk45 (default)": DEFAULT,
     "adaptive rk45, max step 10 ms": IntegratorSettings(max_step=1e-2),
     "adaptive rk45, max step 2.5 ms": IntegratorSettings(max_step=2.5e-3),
-    "adaptive rk45, rtol 1e-4": IntegratorSettings(rtol=1e-4, atol=1e-6),
+    "adaptive rk45, rtol 1e-6": IntegratorSettings(rtol=1e-6, atol=1e-8),
     "adaptive dop853": IntegratorSettings(stepper="dop853"),
     "bdf4 (thesis) 16.6 ms": IntegratorSettings(integrator="bdf4", step=16.6e-3),
     "bdf4 (thesis) 5.6 ms": IntegratorSettings(integrator="bdf4", step=5.6e-3),

@@ -37,8 +37,11 @@ class IntegratorSettings:
     ``bdf4`` (step h in s)."""
 
     integrator: str = "adaptive"
-    rtol: float = 1e-6
-    atol: float = 1e-8
+    #: rtol 1e-4 / atol 1e-6 m: measured by ``design tradeoff
+    #: problems/grasp_mean_bird_hard.yaml``, 1e-6 / 1e-8 cost 48 % more for a
+    #: worst error (hold, peak force) of 0.18 % against 0.11 %
+    rtol: float = 1e-4
+    atol: float = 1e-6
     max_step: float = 5e-3
     stepper: str = "rk45"
     step: float = 5.6e-3
