@@ -57,8 +57,8 @@ def solve(source: str | Path | Mapping, out: str | Path | None = None,
           progress: Progress | None = None) -> dict:
     """Solve a design problem (``kind: design``, a path or the file's content):
     optimise, verify, and return the dict ``design solve`` writes to
-    ``result.json`` (with ``out``, also write it, the CSV tables and
-    ``optimum.yaml`` there). ``result["verification"]["passed"]`` says
+    ``result.json`` (with ``out``, also write it, the CSV tables,
+    ``optimum.yaml`` and ``report.html`` there). ``result["verification"]["passed"]`` says
     whether the independent simulation confirmed the design."""
     scene = load_scene(source)
     if not isinstance(scene, DesignProblem):
