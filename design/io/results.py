@@ -68,6 +68,19 @@ def csv_text(rows: list[dict]) -> str:
     return buf.getvalue()
 
 
+def json_text(value: object) -> str:
+    """The JSON file of a result: numpy values converted, non-finite numbers
+    as null, indented."""
+    return json.dumps(jsonable(value), indent=1, allow_nan=False) + "\n"
+
+
+def write_texts(out_dir: Path, files: dict[str, str]) -> list[Path]:
+    """Write each rendered file (name -> text) atomically; returns the paths."""
+    for name, text in files.items():
+        write_atomic(out_dir / name, text)
+    return [out_dir / name for name in files]
+
+
 def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]],
                   texts: dict[str, str] | None = None) -> list[Path]:
     """Write ``result.json``, each CSV table and further text files; returns
@@ -75,11 +88,7 @@ def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]],
 
     Everything is rendered in memory first, so an error leaves no partial file.
     """
-    files = {"result.json": json.dumps(jsonable(result), indent=1, allow_nan=False) + "\n"}
+    files = {"result.json": json_text(result)}
     files.update({name: csv_text(rows) for name, rows in tables.items()})
     files.update(texts or {})
-    written = []
-    for name, text in files.items():
-        write_atomic(out_dir / name, text)
-        written.append(out_dir / name)
-    return written
+    return write_texts(out_dir, files)

@@ -9,13 +9,12 @@ report is still written, saying which).
 from __future__ import annotations
 
 import argparse
-import json
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 from design import __version__
-from design.io.results import csv_text, jsonable, write_atomic
+from design.io.results import csv_text, json_text, write_texts
 from design.report.page import Page, write_report
 from design.reproduce import beam_rows, contact_rows, grasp_rows
 from design.reproduce.rows import COLUMNS, Section, tally
@@ -115,14 +114,11 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
               "quick": args.quick, "skipped": [grasp_rows.TITLE] if args.quick else [],
               "failures": failures, "agree": agree, "total": total, "columns": list(COLUMNS),
               "rows": [r.as_dict() for r in rows]}
-    files = {"reproduction.json": json.dumps(jsonable(result), indent=1, allow_nan=False) + "\n",
+    files = {"reproduction.json": json_text(result),
              "reproduction.csv": csv_text([r.as_dict() for r in rows])}
     if progress:
         progress(f"writing {out}")
-    for name, text in files.items():
-        write_atomic(out / name, text)
-        print(out / name)
-    for path in write_report(out, page):
+    for path in write_texts(out, files) + write_report(out, page):
         print(path)
     print(f"{agree} of {total} rows agree with the thesis within their stated tolerance"
           + (f"; could not compute: {'; '.join(failures)}" if failures else ""))

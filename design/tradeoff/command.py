@@ -23,7 +23,7 @@ from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
-from design.io.results import write_atomic
+from design.io.results import json_text, write_texts
 from design.io.scene import load_scene
 from design.report.page import write_report
 from design.tradeoff import beam, contact, grasp, optimiser, report
@@ -56,12 +56,10 @@ def cmd_tradeoff(args: argparse.Namespace) -> int:
             "loadavg": {"start": [round(v, 2) for v in start],
                         "end": [round(v, 2) for v in os.getloadavg()]}}
     data = report.result(study, chosen, tolerance, meta)
-    files = {"tradeoff.json": report.json_text(data), "tradeoff.csv": report.csv_table(study)}
+    files = {"tradeoff.json": json_text(data), "tradeoff.csv": report.csv_table(study)}
     page = report.page(study, data, chosen, tolerance)
     out = Path(args.out) if args.out else Path("reports") / f"{name}_tradeoff"
-    for file, text in files.items():
-        write_atomic(out / file, text)
-    written = [out / f for f in files] + write_report(out, page)
+    written = write_texts(out, files) + write_report(out, page)
     print(report.text_table(report.table_rows(study)))
     print()
     for line in data["verdicts"]:

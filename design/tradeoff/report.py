@@ -3,12 +3,11 @@ tradeoff.json, the verdict lines and the error-against-wall-time figure."""
 
 from __future__ import annotations
 
-import json
 import math
 
 import matplotlib.pyplot as plt
 
-from design.io.results import csv_text, jsonable
+from design.io.results import csv_text
 from design.report.page import Page, number
 from design.tradeoff.study import Row, Study
 
@@ -86,10 +85,6 @@ def result(study: Study, chosen: Row | None, tolerance: float | None, meta: dict
             "scene_setting": study.scene_setting, "reference": study.reference,
             "notes": study.notes, "verdicts": verdicts(study, chosen, tolerance),
             "rows": rows}
-
-
-def json_text(data: dict) -> str:
-    return json.dumps(jsonable(data), indent=1, allow_nan=False) + "\n"
 
 
 def figure(study: Study, chosen: Row | None, tolerance: float | None):
