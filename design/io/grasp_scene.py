@@ -28,6 +28,7 @@ from design.physics.beam import Finger
 from design.physics.bird import Bird, Conveyor, Legs
 from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import FingerMount
+from design.solve.grasp.fingers import FINGER_MODELS
 from design.solve.grasp.integrate import INTEGRATORS, IntegratorSettings
 
 _MODEL_KEYS = ("kind", "name", "description", "source", "note")
@@ -184,6 +185,9 @@ class GraspScene:
     duration: float
     settings: GraspSettings
     description: str = ""
+    #: ``spatial`` (the finger as a rod bending both ways, the default) or
+    #: ``planar`` (the thesis's: rigid out of its plane, in-plane force only)
+    finger_model: str = "planar"
 
 
 def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSettings | None:
@@ -231,6 +235,7 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
                         default=Legs().stiffness)
     c = reader.quantity(lg or {}, "damping", "legs", "damping", lo=0.0, default=Legs().damping)
     duration = reader.quantity(data, "duration", "", "time", lo=0.0, lo_open=True, hi=60.0)
+    finger_model = reader.choice(data, "finger_model", "", FINGER_MODELS, default="planar")
     settings = read_grasp_settings(reader, data, "solver")
     if grasper is not None and models:
         grasper = replace(grasper, fingers=tuple(
@@ -242,7 +247,7 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
             reader.add(join("finger_models", group), f"no finger of the grasper is in group "
                                                      f"'{group}'")
     if not reader.ok or None in (grasper, bird, conveyor, omega, x0, mu_f, mu_c, k, c, duration,
-                                 settings):
+                                 settings, finger_model):
         return None
     return GraspScene(name, grasper, bird, conveyor, omega, x0, mu_f, mu_c, Legs(k, c), duration,
-                      settings, data.get("description", ""))
+                      settings, data.get("description", ""), finger_model)

@@ -16,23 +16,57 @@ Beyond the load point the finger is straight.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from design.physics.rod import RUBBER_POISSON
 from design.physics.stiffness import Stiffness
 
 
 @dataclass(frozen=True)
 class Finger:
-    """A compliant finger: length (m) and flexural rigidity profile."""
+    """A compliant finger: length (m) and flexural rigidity profiles.
+
+    ``stiffness`` is EI(s) for bending in the finger's plane (towards y, the
+    soft direction: the planar model's only one). The spatial rod
+    (design/physics/rod.py) also needs ``stiff``, EI about the section's
+    other axis (bending towards z), and ``torsion``, GJ(s); each defaults to
+    a round section's: EI_out = EI, GJ = EI / (1 + ν) (J = 2 I,
+    G = E / (2 (1 + ν)), ν = 0.5 for rubber).
+    """
 
     length: float
     stiffness: Stiffness
     name: str = ""
+    stiff: Stiffness | None = None
+    torsion: Stiffness | None = None
+
+    @property
+    def stiffness_out(self) -> Stiffness:
+        """EI(s) for bending out of the finger's plane (N m²)."""
+        return self.stiffness if self.stiff is None else self.stiff
+
+    @property
+    def torsion_rigidity(self) -> Stiffness:
+        """GJ(s) (N m²)."""
+        if self.torsion is not None:
+            return self.torsion
+        return self.stiffness.scaled(1.0 / (1.0 + RUBBER_POISSON))
+
+    def scaled(self, factor: float) -> "Finger":
+        """The same finger in a material ``factor`` times stiffer (a new E)."""
+        return replace(self, stiffness=self.stiffness.scaled(factor),
+                       stiff=None if self.stiff is None else self.stiff.scaled(factor),
+                       torsion=None if self.torsion is None else self.torsion.scaled(factor))
 
     def describe(self) -> dict:
-        return {"name": self.name, "length": self.length, "stiffness": self.stiffness.describe()}
+        out = {"name": self.name, "length": self.length, "stiffness": self.stiffness.describe()}
+        if self.stiff is not None:
+            out["stiffness_out_of_plane"] = self.stiff.describe()
+        if self.torsion is not None:
+            out["torsion"] = self.torsion.describe()
+        return out
 
 
 @dataclass(frozen=True)

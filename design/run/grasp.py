@@ -11,7 +11,7 @@ from design.solve.grasp.simulation import GraspRun, GraspSetup, simulate_grasp
 def setup_of(scene: GraspScene) -> GraspSetup:
     return GraspSetup(scene.grasper, scene.bird, scene.conveyor, scene.drum_speed,
                       scene.start_x, scene.finger_friction, scene.conveyor_friction, scene.legs,
-                      scene.duration)
+                      scene.duration, scene.finger_model)
 
 
 def timeseries(run: GraspRun) -> list[dict]:

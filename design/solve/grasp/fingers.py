@@ -1,11 +1,24 @@
 """Finger forces on the bird in 3-D, both drums (thesis §4.3; MODEL.md §4).
 
 For every finger of the right drum at time t and bird pose (X, Z, θ): the
-finger's frame, the ellipse in which its bending plane cuts the bird, the
-2-D contact solved in that plane (continued from the finger's previous
-state), and the force mapped back to the world. The left drum's finger is
-the mirror image: same force magnitudes, Y components opposite, so the
-symmetric grasp sees twice the right drum's X and Z forces and moment.
+finger's frame on the drum and its contact with the bird, continued from the
+finger's previous state, mapped back to the world. Two contact models:
+
+* ``planar`` (the thesis's): the finger's bending plane cuts the bird in an
+  ellipse, the 2-D contact is solved in it and only its in-plane force acts;
+* ``spatial``: the finger is a rod bending about both section axes and
+  twisting (design/physics/rod.py) against the whole ellipsoid; the force
+  acts along the surface normal with 3-D Coulomb friction.
+
+Every contact reports how far it leaves the finger's bending plane (the
+out-of-plane shares of the surface normal and of the sweep), which is what
+decides whether the planar model may be used. A contact that cannot be
+solved raises :class:`ContactFailed`: the run stops there instead of
+counting the finger's force as zero.
+
+The left drum's finger is the mirror image: same force magnitudes, Y
+components opposite, so the symmetric grasp sees twice the right drum's X
+and Z forces and moment.
 
 Model only what can touch: :func:`reach_windows` finds, from the undeformed
 finger loci (eq. 5.1), the time windows in which a finger can reach the bird
@@ -24,6 +37,8 @@ from design.physics.ellipse import Ellipse
 from design.physics.grasper import Grasper
 from design.physics.kinematics import Ellipsoid
 from design.solve.contact import RobustContact
+from design.solve.contact.spatial import (Quadric, SpatialContact, SpatialSolution,
+                                          segment_level, sliding_friction)
 
 #: finite-difference step (s) for the rates the friction direction needs
 RATE_STEP = 1e-6
@@ -31,16 +46,27 @@ RATE_STEP = 1e-6
 #: this (m/s): flipping it at every sign change of the sliding speed, decided
 #: at accepted steps, chatters (measured: 50-80 N force jumps every 1-5 ms)
 REVERSAL_SPEED = 0.02
+#: the spatial finger's Coulomb friction is regularised below this sliding
+#: speed (m/s): F_t = -µ N v / sqrt(|v|² + ε²); the drum sweeps the fingers
+#: past the bird at 0.1-0.5 m/s, so friction is within 1% of µ N above 0.14 m/s
+FRICTION_SPEED = 0.02
 
 
 @dataclass
 class FingerState:
-    """One finger's contact at one instant (right drum), world frame."""
+    """One finger's contact at one instant (right drum), world frame.
+
+    ``normal_out_of_plane`` and ``sweep_out_of_plane`` (0-1): the shares of
+    the bird's surface normal and of the finger's sliding over the surface
+    along the finger's stiff axis (see :meth:`FingerForces._shares`).
+    """
 
     force: np.ndarray = field(default_factory=lambda: np.zeros(3))   # on the bird, N
     point: np.ndarray | None = None                                  # world, m
     body_point: np.ndarray | None = None                             # bird frame, m
-    solution: ContactSolution | None = None
+    solution: ContactSolution | SpatialSolution | None = None
+    normal_out_of_plane: float = 0.0
+    sweep_out_of_plane: float = 0.0
 
     @property
     def magnitude(self) -> float:
@@ -96,24 +122,109 @@ def _segment_box_distance(a, b, xr, yr, zr, samples: int = 24) -> float:
     return float(np.min(np.linalg.norm(d, axis=1)))
 
 
+class ContactFailed(RuntimeError):
+    """A finger's contact could not be solved: the run cannot go on honestly
+    (counting the finger's force as zero would lower the peak force)."""
+
+    def __init__(self, t: float, finger: str, message: str):
+        super().__init__(f"finger {finger}'s contact failed at t = {t:.4f} s: {message}")
+        self.t, self.finger, self.reason = t, finger, message
+
+
+class PlanarFinger:
+    """The thesis's finger (§4.3): rigid out of its bending plane; the plane
+    cuts the bird in an ellipse, the planar contact is solved in it and only
+    its in-plane force acts (eq. 4.26: no force along z_f). Friction at the
+    edge of sliding, reversed when the finger clearly slides the other way."""
+
+    name = "planar"
+
+    def __init__(self, finger, friction: float, intervals: int, degree: int,
+                 reversal_speed: float = REVERSAL_SPEED):
+        self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
+                                    reversal_speed=reversal_speed)
+
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
+        """(force on the bird (3,) world, contact point (3,) world, solution,
+        state to continue from); force None when the plane misses the bird."""
+        cut = body.cut(base, R)
+        if cut is None:
+            return None, None, None, None
+        kin = kin_factory(cut)
+        sol, cont = self.solver.solve_frame(cut, "auto", kin, start, settle=commit,
+                                            detail=commit)
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        f_w = R[:, :2] @ sol.force_on_object_finger_frame
+        p_w = base + R[:, :2] @ np.asarray(sol.point)
+        return f_w, p_w, sol, cont
+
+
+class SpatialFinger:
+    """The finger as a spatial rod (design/physics/rod.py): it bends about both
+    section axes and twists, so the contact force acts along the bird's
+    surface normal, with Coulomb friction opposite to the finger's sliding
+    over the surface, regularised below FRICTION_SPEED.
+
+    The sliding velocity is the rigid finger's (carried by the drum) relative
+    to the bird's surface at the contact point of the latest solution; the
+    finger's own deflection rate is left out. So the friction is a smooth
+    function of the bird's state within every integrator stage, not a value
+    lagging one step behind it (which, measured on the football, made the
+    regularised friction an explicit feedback that forced 2000+ tiny steps).
+    :meth:`SpatialContact.sliding_velocity` gives the full material velocity
+    for comparison.
+    """
+
+    name = "spatial"
+
+    def __init__(self, finger, friction: float, intervals: int, degree: int):
+        self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
+        self.mu = float(friction)
+
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
+        quadric = body_quadric(body, base, R)
+        if segment_level(quadric, self.solver.finger.length) >= 0.0:
+            return None, None, None, None
+        friction = np.zeros(3)
+        if start is not None and self.mu > 0:
+            _, v_object = kin_factory(quadric)(start.post[:3])
+            friction = sliding_friction(self.mu, -v_object - (-v_object @ start.post[7:10])
+                                        * start.post[7:10], FRICTION_SPEED)
+        sol, cont = self.solver.solve(quadric, friction, start, detail=commit)
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        return R @ sol.force, base + R @ sol.point, sol, cont
+
+
+#: contact models by name
+FINGER_MODELS = {"planar": PlanarFinger, "spatial": SpatialFinger}
+
+
+def body_quadric(body: Ellipsoid, base: np.ndarray, R: np.ndarray) -> Quadric:
+    """The bird's ellipsoid in a finger frame (base, R) as a quadric."""
+    Rb = R.T @ body.rotation
+    return Quadric(R.T @ (np.asarray(body.center, float) - base), Rb @ body.matrix @ Rb.T)
+
+
 class FingerForces:
     """All fingers' forces on the bird, continued in time finger by finger.
 
     ``evaluate(t, y, commit)`` returns the summed loads and each finger's
     state. Trial evaluations (``commit`` false) keep each contact's friction
-    ratio from the last committed state; committed ones (accepted integrator
+    from the last committed state; committed ones (accepted integrator
     steps) also decide it from the sliding velocity and become the states
-    later evaluations continue from.
+    later evaluations continue from. A contact that cannot be solved raises
+    :class:`ContactFailed`.
     """
 
     def __init__(self, grasper: Grasper, bird: Bird, drum_speed: float, friction: float,
                  windows: list[list[tuple[float, float]]] | None = None,
-                 intervals: int = 8, degree: int = 4, reversal_speed: float = REVERSAL_SPEED):
+                 intervals: int = 8, degree: int = 4, model: str = "planar"):
         self.grasper, self.bird = grasper, bird
         self.drum = grasper.drum(drum_speed)
-        self.solvers = [RobustContact(gf.finger, friction, intervals=intervals, degree=degree,
-                                      reversal_speed=reversal_speed)
-                        for gf in grasper.fingers]
+        kind = FINGER_MODELS[model]
+        self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
         self.windows = windows
         self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
@@ -148,46 +259,67 @@ class FingerForces:
         loads, states = Loads(), []
         centre = np.array([y[0], 0.0, y[1]])
         for i, gf in enumerate(self.grasper.fingers):
-            if not self.active(i, t):
+            force = None
+            if self.active(i, t):
+                base, R = self.drum.frame(gf.mount, t)
+                # continue from the latest solution, trial or committed: the nearest
+                # in time (trials keep the committed friction)
+                start = self.states[i] if commit else self.trials[i]
+                force, p_w, sol, cont = self.models[i].solve(
+                    body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
+                    commit)
+            else:
                 self.skipped += 1
+            if force is None:                       # out of reach: no contact problem
                 self.trials[i] = None
                 if commit:
                     self.states[i] = None
                 states.append(FingerState())
                 continue
-            base, R = self.drum.frame(gf.mount, t)
-            cut = body.cut(base, R)
-            if cut is None:
-                self.trials[i] = None
-                if commit:
-                    self.states[i] = None
-                states.append(FingerState())
-                continue
-            kin = self._kinematics(i, t, y, cut)
             self.solves += 1
-            # continue from the latest solution, trial or committed: the nearest
-            # in time (trials keep the committed friction ratio)
-            start = self.states[i] if commit else self.trials[i]
-            sol, cont = self.solvers[i].solve_frame(cut, "auto", kin, start,
-                                                    settle=commit, detail=commit)
+            if not sol.converged:
+                raise ContactFailed(t, gf.name, sol.message)
             self.trials[i] = cont
             if commit:
                 self.states[i] = cont
-            if not sol.contact:
+            if p_w is None:
                 states.append(FingerState(solution=sol))
                 continue
-            f_w = R[:, :2] @ sol.force_on_object_finger_frame
-            p_w = base + R[:, :2] @ np.asarray(sol.point)
             r = p_w - centre
-            loads.qx += 2 * f_w[0]
-            loads.qz += 2 * f_w[2]
-            loads.ty += 2 * (r[2] * f_w[0] - r[0] * f_w[2])
-            states.append(FingerState(f_w, p_w, body.rotation.T @ r, sol))
+            loads.qx += 2 * force[0]
+            loads.qz += 2 * force[2]
+            loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
+            states.append(FingerState(force, p_w, body.rotation.T @ r, sol,
+                                      *self._shares(i, t, y, body, p_w)))
         return loads, states
 
-    def _kinematics(self, i: int, t: float, y: np.ndarray, cut: Ellipse):
-        """Rates of the cut ellipse and the bird's surface velocity relative to
-        finger i's frame, by a forward difference over RATE_STEP."""
+    def _shares(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, p_w: np.ndarray
+                ) -> tuple[float, float]:
+        """How far a contact leaves the finger's bending plane: the share of the
+        bird's surface normal along the stiff axis z_f, |n·z_f|, and of the
+        finger's sweep over the surface, |v·z_f| / |v| (v the rigid finger's
+        velocity relative to the bird's surface at the contact)."""
+        gf = self.grasper.fingers[i]
+        base, R = self.drum.frame(gf.mount, t)
+        p_b = body.rotation.T @ (p_w - np.asarray(body.center))
+        n = body.rotation @ (body.matrix @ p_b)
+        n /= np.linalg.norm(n)
+        dt = RATE_STEP
+        base2, R2 = self.drum.frame(gf.mount, t + dt)
+        frame_v = (base2 + R2 @ (R.T @ (p_w - base)) - p_w) / dt
+        y2 = y.copy()
+        y2[:3] += dt * y[3:]
+        body2 = self.ellipsoid(y2)
+        object_v = (np.asarray(body2.center) + body2.rotation @ p_b - p_w) / dt
+        v = frame_v - object_v
+        v -= (v @ n) * n
+        speed = np.linalg.norm(v)
+        return float(abs(n @ R[:, 2])), float(abs(v @ R[:, 2]) / speed) if speed > 0 else 0.0
+
+    def _kinematics(self, i: int, t: float, y: np.ndarray, shape):
+        """Rates of the bird's section (planar: the cut ellipse) or quadric
+        (spatial) in finger i's frame, and the bird's surface velocity
+        relative to that frame, by a forward difference over RATE_STEP."""
         gf = self.grasper.fingers[i]
         dt = RATE_STEP
         y2 = y.copy()
@@ -195,6 +327,19 @@ class FingerForces:
         base, R = self.drum.frame(gf.mount, t)
         base2, R2 = self.drum.frame(gf.mount, t + dt)
         body, body2 = self.ellipsoid(y), self.ellipsoid(y2)
+        planar = isinstance(shape, Ellipse)
+
+        def surface_velocity(p_f: np.ndarray) -> np.ndarray:
+            p3 = np.concatenate([p_f, [0.0]]) if planar else p_f
+            p_w = base + R @ p3
+            p_b = body.rotation.T @ (p_w - np.array(body.center))
+            p_w2 = np.array(body2.center) + body2.rotation @ p_b
+            return (R2.T @ (p_w2 - base2) - p3) / dt
+
+        if not planar:
+            rates = (body_quadric(body2, base2, R2).params - shape.params) / dt
+            return lambda p_f: (rates, surface_velocity(p_f))
+        cut = shape
 
         def kin(p_f: np.ndarray):
             cut2 = body2.cut(base2, R2)
@@ -208,11 +353,7 @@ class FingerForces:
                 d_th = (th2 - cut.theta + np.pi / 2) % np.pi - np.pi / 2
                 q_dot = np.array([cut2.center[0] - cut.center[0], cut2.center[1] - cut.center[1],
                                   d_th, a2 - cut.a, b2 - cut.b]) / dt
-            p_w = base + R[:, :2] @ p_f
-            p_b = body.rotation.T @ (p_w - np.array(body.center))
-            p_w2 = np.array(body2.center) + body2.rotation @ p_b
-            p_f2 = R2.T @ (p_w2 - base2)
-            return q_dot, (p_f2[:2] - p_f) / dt
+            return q_dot, surface_velocity(p_f)[:2]
 
         return kin
 

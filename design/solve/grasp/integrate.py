@@ -25,7 +25,7 @@ from scipy.integrate import DOP853, RK45
 from scipy.optimize import brentq
 
 from design.physics.bird import BirdDynamics, Conveyor, Loads
-from design.solve.grasp.fingers import FingerForces, FingerState
+from design.solve.grasp.fingers import ContactFailed, FingerForces, FingerState
 
 STEPPERS = {"dop853": DOP853, "rk45": RK45}
 INTEGRATORS = ("adaptive", "bdf4")
@@ -107,9 +107,16 @@ class Grasp:
 
 def integrate(grasp: Grasp, y0: np.ndarray, t_end: float, settings: IntegratorSettings,
               progress=None) -> Trajectory:
+    """Integrate from y0 over [0, t_end]. A finger contact that cannot be
+    solved ends the run there: ``ok`` false, the time and finger in
+    ``message`` (the records so far are kept)."""
     run = {"adaptive": _adaptive, "bdf4": _bdf4}[settings.integrator]
     t0 = time.perf_counter()
-    traj = run(grasp, y0, t_end, settings, progress)
+    traj = Trajectory()
+    try:
+        run(grasp, traj, y0, t_end, settings, progress)
+    except ContactFailed as exc:
+        traj.ok, traj.message = False, str(exc)
     traj.wall_time = time.perf_counter() - t0
     return traj
 
@@ -214,8 +221,7 @@ def _locate(f, dense, t_old: float, t_new: float) -> float:
     return brentq(g, t_old, t_new, xtol=1e-12)
 
 
-def _adaptive(grasp: Grasp, y0, t_end, s: IntegratorSettings, progress) -> Trajectory:
-    traj = Trajectory()
+def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, progress):
     t = 0.0
     mode, slip_sign, y = decide_mode(grasp, t, np.asarray(y0, float))
     traj.records.append(grasp.record(t, y, mode, slip_sign))
@@ -256,9 +262,9 @@ def _adaptive(grasp: Grasp, y0, t_end, s: IntegratorSettings, progress) -> Traje
                 traj.records.append(grasp.record(t, y, mode, slip_sign))
                 restart = True
                 continue
-            before = [None if st is None else st.tau_mu for st in grasp.fingers.states]
+            before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
             traj.records.append(grasp.record(t_new, y_new, mode, slip_sign))
-            after = [None if st is None else st.tau_mu for st in grasp.fingers.states]
+            after = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
             t, y = t_new, y_new
             if any(a is not None and b is not None and a != b for a, b in zip(before, after)):
                 # a finger's friction turned: a new smooth piece, and the belt
@@ -278,9 +284,8 @@ _BDF = {1: ([1.0], 1.0), 2: ([4 / 3, -1 / 3], 2 / 3), 3: ([18 / 11, -9 / 11, 2 /
         4: ([48 / 25, -36 / 25, 16 / 25, -3 / 25], 12 / 25)}
 
 
-def _bdf4(grasp: Grasp, y0, t_end, s: IntegratorSettings, progress) -> Trajectory:
+def _bdf4(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, progress):
     """Thesis §4.4: BDF of order 4 (lower orders to start), forces frozen."""
-    traj = Trajectory()
     dyn, h = grasp.dyn, s.step
     y = dyn.settle(np.asarray(y0, float))
     t = 0.0

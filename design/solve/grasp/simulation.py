@@ -26,6 +26,8 @@ class GraspSetup:
     conveyor_friction: float
     legs: Legs
     duration: float
+    #: the fingers' contact model: ``spatial`` (rod, default) or ``planar`` (thesis)
+    finger_model: str = "planar"
 
 
 @dataclass
@@ -49,7 +51,7 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     b, conv = setup.bird, setup.conveyor
     windows = setup_reach_windows(setup) if reach_filter else None
     fingers = FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction, windows,
-                           intervals=contact_nodes)
+                           intervals=contact_nodes, model=setup.finger_model)
     dyn = BirdDynamics(b, setup.legs, setup.conveyor_friction)
     grasp = Grasp(dyn, conv, fingers)
     y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])

@@ -1,0 +1,128 @@
+"""A spatial rod finger against an ellipsoid (design/solve/contact/spatial.py):
+the planar contact as a special case, rotation invariance, the contact
+conditions, friction, and the situations every contact solver must handle."""
+
+import numpy as np
+import pytest
+
+from design.physics.beam import Finger
+from design.physics.ellipse import Ellipse
+from design.physics.kinematics import rot_x
+from design.physics.stiffness import UniformEI
+from design.solve.contact import RobustContact
+from design.solve.contact.spatial import Quadric, SpatialContact, sliding_friction
+from tests.problems import thesis_finger, uniform_finger
+
+#: semi-axis (m) along the finger frame's z of the ellipsoid built on a planar ellipse
+DEPTH = 0.5
+
+
+def ellipsoid_on(ell: Ellipse, beta: float = 0.0) -> Quadric:
+    """The ellipsoid whose section by the finger's plane is ``ell``, long along z
+    (so the contact stays in the plane), turned by β about the finger's axis."""
+    R2 = np.array([[np.cos(ell.theta), -np.sin(ell.theta)],
+                   [np.sin(ell.theta), np.cos(ell.theta)]])
+    Q = np.zeros((3, 3))
+    Q[:2, :2] = R2 @ np.diag([1 / ell.a ** 2, 1 / ell.b ** 2]) @ R2.T
+    Q[2, 2] = 1 / DEPTH ** 2
+    Rx = rot_x(beta)
+    return Quadric(Rx @ np.array([*ell.center, 0.0]), Rx @ Q @ Rx.T)
+
+
+#: objects in the finger frame: light, deep (contact near the middle), tip contact
+ELLIPSES = {"light": Ellipse(0.0991, 0.0673, (0.12, -0.07), 0.3),
+            "deep": Ellipse(0.0991, 0.0673, (0.14, -0.03), 0.2),
+            "tip": Ellipse(0.0991, 0.0673, (0.26, -0.03), 0.5)}
+
+
+@pytest.mark.parametrize("name", ELLIPSES)
+@pytest.mark.parametrize("finger", [thesis_finger(), uniform_finger()], ids=["soft", "EI=0.08"])
+def test_the_planar_contact_is_the_in_plane_special_case(finger, name):
+    """An object symmetric about the finger's plane: the rod's contact is the
+    planar solver's (frictionless), force and point, to 1e-7 relative (two
+    transcriptions on the same mesh, K = 10, each within ~1e-9 of exact)."""
+    ell = ELLIPSES[name]
+    planar = RobustContact(finger, 0.0, intervals=10).solve_frame(ell, "auto", None, None)[0]
+    sol, _ = SpatialContact(finger, intervals=10).solve(ellipsoid_on(ell))
+    assert sol.converged and sol.contact and planar.contact
+    assert sol.tip_contact == planar.tip_contact == (name == "tip")
+    scale = np.hypot(*planar.force_on_object_finger_frame)
+    np.testing.assert_allclose(sol.force, [*planar.force_on_object_finger_frame, 0.0],
+                               atol=1e-7 * scale)
+    np.testing.assert_allclose(sol.point, [*planar.point, 0.0], atol=1e-7)
+
+
+@pytest.mark.parametrize("beta", [0.4, 1.3, -2.0])
+def test_a_round_finger_is_indifferent_to_how_the_object_is_turned_about_it(beta):
+    """Turning the object by β about the axis of a round finger turns the whole
+    solution by β (to 1e-7 relative: Newton and continuation paths differ)."""
+    finger = uniform_finger()
+    ell = ELLIPSES["deep"]
+    flat, _ = SpatialContact(finger).solve(ellipsoid_on(ell))
+    turned, _ = SpatialContact(finger).solve(ellipsoid_on(ell, beta))
+    Rx = rot_x(beta)
+    np.testing.assert_allclose(turned.force, Rx @ flat.force, atol=1e-7 * np.linalg.norm(flat.force))
+    np.testing.assert_allclose(turned.point, Rx @ flat.point, atol=1e-8)
+
+
+def test_a_stiffer_axis_turns_the_push_towards_the_soft_one():
+    """An object pressing at 45° between the section axes: a round finger yields
+    straight away from it; one 4x stiffer about z yields mostly along y, and
+    carries the z part of the normal force without much deflection."""
+    ell = ELLIPSES["deep"]
+    round_, _ = SpatialContact(uniform_finger()).solve(ellipsoid_on(ell, np.pi / 4))
+    stiff_finger = Finger(0.203, UniformEI(0.08), stiff=UniformEI(0.32))
+    stiff, _ = SpatialContact(stiff_finger).solve(ellipsoid_on(ell, np.pi / 4))
+    assert stiff.converged and round_.converged
+    assert abs(round_.point[1] - round_.point[2]) < 1e-8        # along the 45° diagonal
+    assert abs(stiff.point[1]) > 1.5 * abs(stiff.point[2])     # yields along y
+
+
+@pytest.mark.parametrize("name", ["light", "deep", "tip"])
+def test_contact_conditions_hold(name):
+    """The contact point lies on the surface; inside the span the rod is tangent
+    to it; the rod passes nowhere else through the object (1e-9)."""
+    quadric = ellipsoid_on(ELLIPSES[name], 0.7)
+    sol, state = SpatialContact(thesis_finger()).solve(quadric)
+    assert abs(quadric.level(sol.point[:, None])[0]) < 1e-9
+    if not sol.tip_contact:
+        assert abs(state.post[13:16] @ sol.normal) < 1e-9
+    assert sol.penetration == 0.0 and sol.converged
+
+
+def test_friction_is_coulomb_on_the_tangent_plane():
+    """With a friction vector t the force on the finger is N (n + t_p), t_p the
+    tangential part of t: its tangential share is |t_p| (µ when sliding)."""
+    quadric = ellipsoid_on(ELLIPSES["deep"], 0.3)
+    sliding = np.array([0.3, 0.1, -0.2])
+    t = sliding_friction(0.6, sliding, 0.0)
+    sol, _ = SpatialContact(thesis_finger()).solve(quadric, t)
+    on_finger = -sol.force
+    normal_part = on_finger @ sol.normal
+    tangential = on_finger - normal_part * sol.normal
+    t_p = t - (t @ sol.normal) * sol.normal
+    assert normal_part > 0
+    np.testing.assert_allclose(tangential, normal_part * t_p, atol=1e-9 * normal_part)
+
+
+def test_continued_and_fresh_solutions_agree():
+    """Following the object in 20 steps gives the solution found directly from
+    first touch (one equilibrium on this path; to 1e-8 relative)."""
+    solver = SpatialContact(thesis_finger())
+    target = ellipsoid_on(ELLIPSES["deep"], 0.5)
+    state = None
+    for k in np.linspace(0.0, 1.0, 21):
+        quadric = target.shifted(np.array([0.0, -0.03, 0.0]) * (1 - k))
+        sol, state = solver.solve(quadric, np.zeros(3), state)
+    fresh, _ = SpatialContact(thesis_finger()).solve(target)
+    np.testing.assert_allclose(sol.force, fresh.force, atol=1e-8 * np.linalg.norm(fresh.force))
+
+
+def test_no_contact_and_invalid_poses_are_told_apart():
+    solver = SpatialContact(thesis_finger())
+    far = ellipsoid_on(Ellipse(0.0991, 0.0673, (0.12, -0.2)))
+    sol, _ = solver.solve(far)
+    assert sol.converged and not sol.contact and "misses" in sol.message
+    on_base = ellipsoid_on(Ellipse(0.0991, 0.0673, (0.0, 0.0)))
+    sol, _ = solver.solve(on_base)
+    assert not sol.converged and "base is inside" in sol.message
