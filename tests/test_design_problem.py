@@ -28,11 +28,11 @@ def test_shipped_problems_are_valid():
 
 
 def test_units_and_caps_are_read_in_si():
-    p = design.check(problem(variables={"fingers.4.angle": ["-160 deg", "-140 deg"],
+    p = design.check(problem(variables={"fingers.4.angle": ["100 deg", "120 deg"],
                                         "conveyor.rate": ["50 cm/s^2", "3 m/s^2"]},
                              cap=[{"relative_to_baseline": 0.75}, "40 N", "baseline"]))
     lo, hi = p.variables["fingers.4.angle"]
-    assert lo == pytest.approx(-160 * 3.141592653589793 / 180) and hi > lo
+    assert lo == pytest.approx(100 * 3.141592653589793 / 180) and hi > lo
     assert p.variables["conveyor.rate"] == pytest.approx((0.5, 3.0))
     assert [c.resolve(50.0) for c in p.caps] == pytest.approx([37.5, 40.0, 50.0])
     assert p.pareto
@@ -41,6 +41,8 @@ def test_units_and_caps_are_read_in_si():
 @pytest.mark.parametrize("change, field, text", [
     ({"variables": {"fingers.4.angle": ["-140 deg", "-160 deg"]}}, "variables.fingers.4.angle",
      "is not below upper bound"),
+    ({"variables": {"fingers.4.angle": ["-160 deg", "-140 deg"]}}, "variables.fingers.4.angle",
+     "do not contain the baseline's value 1.9635"),
     ({"variables": {"fingers.9.angle": [0, 1]}}, "variables.fingers.9.angle",
      "no such design variable"),
     ({"variables": {"groups.lower.stifness_scale": [0.5, 2]}},

@@ -20,7 +20,7 @@ def test_grasp_scene_writes_summary_and_timeseries(tmp_path):
     assert result["kind"] == "grasp" and result["summary"]["hold_windows"] == []
     assert result["bird"]["mass"] == 1.8 and result["conveyor"]["speed"] == pytest.approx(0.4572)
     rows = list(csv.DictReader((tmp_path / "timeseries.csv").open()))
-    assert {"t_s", "X_m", "Z_m", "theta_rad", "N_N", "belt_friction_N", "F4_x_N", "P4_x_m"} <= set(rows[0])
+    assert {"t_s", "X_m", "Z_m", "theta_rad", "N_N", "belt_friction_N", "F4a_x_N", "P4a_x_m"} <= set(rows[0])
     assert float(rows[-1]["t_s"]) == pytest.approx(0.2)
 
 
@@ -56,3 +56,24 @@ def test_bad_grasp_input(tmp_path, capsys, change, field, text):
     err = capsys.readouterr().err
     assert f"{path}: {field}: " in err and text in err, err
     assert not (tmp_path / "out").exists()
+
+
+def test_mounts_change_every_set_of_a_finger():
+    """`mounts: {"3": {phi_x: 60 deg}}` (the football's finger 3, Fig 5-16)
+    turns 3a, 3b and 3c alike and nothing else; an angle is set a's."""
+    import math
+
+    from design.errors import ProblemFileError
+    base = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"])})
+    changed = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
+                            "mounts": {"3": {"phi_x": "60 deg", "angle": "80 deg"}}})
+    for a, b in zip(base.grasper.fingers, changed.grasper.fingers):
+        if a.design_name == "3":
+            assert b.mount.phi_x == pytest.approx(math.radians(60))
+            assert b.mount.angle - b.phase == pytest.approx(math.radians(80))
+        else:
+            assert b.mount == a.mount
+    with pytest.raises(ProblemFileError) as err:
+        design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
+                      "mounts": {"9": {"phi_x": "60 deg"}}})
+    assert any(p.field == "mounts.9" and "no finger '9'" in p.message for p in err.value.problems)

@@ -140,3 +140,19 @@ def test_units_in_scene_files(tmp_path):
     case = result["cases"][0]
     assert case["at"] == pytest.approx(0.1016) and case["alpha"] == pytest.approx(1.5707963267948966)
     assert case["tip"]["y"] == pytest.approx(0.049184, abs=2e-5)   # EI = 0.0800016
+
+
+@pytest.mark.parametrize("name", ["thesis_nonuniform_hard.yaml", "thesis_nonuniform_soft.yaml",
+                                  "thesis_uniform.yaml"])
+def test_written_finger_keeps_every_rigidity(name):
+    """A finger written into a scene (optimum.yaml) reads back with the same
+    in-plane, out-of-plane and torsional rigidity profiles."""
+    import numpy as np
+
+    from design.io.scene_writer import finger_spec
+    finger = design.check(ROOT / "models" / "fingers" / name)
+    again = design.check({"kind": "finger", **finger_spec(finger)})
+    s = np.linspace(0.0, finger.length, 7)
+    for a, b in [(finger.stiffness, again.stiffness), (finger.stiffness_out, again.stiffness_out),
+                 (finger.torsion_rigidity, again.torsion_rigidity)]:
+        np.testing.assert_allclose(b.ei(s), a.ei(s), rtol=1e-12)

@@ -74,7 +74,8 @@ class DesignProblem:
 
 
 def variable_names(scene: GraspScene) -> list[str]:
-    names = [f"fingers.{gf.name}.{f}" for gf in scene.grasper.fingers for f in FINGER_FIELDS]
+    families = dict.fromkeys(gf.design_name for gf in scene.grasper.fingers)
+    names = [f"fingers.{name}.{f}" for name in families for f in FINGER_FIELDS]
     names += [f"groups.{g}.{f}" for g in sorted({gf.group for gf in scene.grasper.fingers})
               for f in GROUP_FIELDS]
     return names + [f"conveyor.{f}" for f in CONVEYOR_FIELDS] + list(GLOBAL_FIELDS)
@@ -134,6 +135,7 @@ def _variables(reader: Reader, value: object, scene: GraspScene | None):
         reader.add("variables", "no design variable given")
         return None
     allowed = variable_names(scene) if scene is not None else None
+    base = _baseline_values(scene) if scene is not None else {}
     out = {}
     for key, bounds in spec.items():
         path = join("variables", str(key))
@@ -153,9 +155,23 @@ def _variables(reader: Reader, value: object, scene: GraspScene | None):
         elif key.endswith(("stiffness_scale", "rate", "length", "drum_speed", "spacing",
                            "final_speed")) and values[0] <= 0:
             reader.add(path, f"lower bound {values[0]:g} must be > 0")
+        elif key in base and not values[0] <= base[key] <= values[1]:
+            reader.add(path, f"the bounds [{values[0]:g}, {values[1]:g}] do not contain the "
+                             f"baseline's value {base[key]:g} (SI)")
         else:
             out[key] = (values[0], values[1])
     return out
+
+
+def _baseline_values(scene: GraspScene) -> dict[str, float]:
+    """The scene's own value of every design variable (SI), except the belt's
+    deceleration start, which a simulation decides."""
+    from design.run.grasp import setup_of
+    from design.solve.optimize.variables import parameters_of, timed_conveyor
+    setup = setup_of(scene)
+    values = parameters_of(replace(setup, conveyor=timed_conveyor(setup.conveyor, 0.0)))
+    values.pop("conveyor.start_time")
+    return values
 
 
 def _caps(reader: Reader, value: object) -> list[Cap] | None:

@@ -6,6 +6,7 @@ birds and conveyor profiles (each inline or a file under ``models/``).
     kind: grasp
     grasper: models/graspers/thesis_table_5_1.yaml
     finger_models: {lower: models/fingers/thesis_nonuniform_soft.yaml}   # optional
+    mounts: {"3": {phi_x: 60 deg}}     # optional: change a designed finger (every set)
     bird: models/birds/mean_1_80kg.yaml
     conveyor: models/conveyors/constant_0457.yaml     # or {speed: 0.457, ...}
     drum_speed: 20 rpm
@@ -21,6 +22,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+import numpy as np
+
 from design.io.fingers import read_finger
 from design.io.files import read_model
 from design.io.reader import Reader, join
@@ -29,7 +32,7 @@ from design.physics.bird import Bird, Conveyor, Legs
 from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import FingerMount
 from design.solve.grasp.fingers import FINGER_MODELS
-from design.solve.grasp.integrate import INTEGRATORS, IntegratorSettings
+from design.solve.grasp.integrate import INTEGRATORS, STEPPERS, IntegratorSettings
 
 _MODEL_KEYS = ("kind", "name", "description", "source", "note")
 
@@ -37,12 +40,13 @@ _MODEL_KEYS = ("kind", "name", "description", "source", "note")
 def _grasper(reader: Reader, data: object, field_name: str, base_dir: Path,
              default_name: str) -> Grasper | None:
     spec = reader.mapping(data, field_name, required=("spacing", "fingers"),
-                          optional=(*_MODEL_KEYS, "tilt", "x", "finger_models"))
+                          optional=(*_MODEL_KEYS, "tilt", "x", "sets", "finger_models"))
     if spec is None:
         return None
     spacing = reader.quantity(spec, "spacing", field_name, "length", lo=0.0, lo_open=True)
     tilt = reader.quantity(spec, "tilt", field_name, "angle", lo=-1.5, hi=1.5, default=0.0)
     x = reader.quantity(spec, "x", field_name, "length", default=0.0)
+    sets = reader.integer(spec, "sets", field_name, lo=1, hi=12, default=1)
     models = read_finger_models(reader, spec, join(field_name, "finger_models"), base_dir)
     fingers = []
     raw = spec.get("fingers")
@@ -71,11 +75,27 @@ def _grasper(reader: Reader, data: object, field_name: str, base_dir: Path,
                                          f"own 'finger')")
         if None in (length, height, radius, angle, phi_x, phi_y, model):
             continue
-        fingers.append(GraspFinger(name, Finger(length, model.stiffness, model.name),
+        fingers.append(GraspFinger(name, replace(model, length=length),
                                    FingerMount(angle, height, radius, phi_x, phi_y), group))
-    if not reader.ok or spacing is None:
+    if not reader.ok or spacing is None or sets is None:
         return None
-    return Grasper(tuple(fingers), spacing, tilt, x, spec.get("name", default_name))
+    return Grasper(mounted_sets(fingers, sets), spacing, tilt, x,
+                   spec.get("name", default_name), sets)
+
+
+def mounted_sets(fingers: list[GraspFinger], sets: int) -> tuple[GraspFinger, ...]:
+    """Each designed finger mounted ``sets`` times, 2π/sets apart (thesis eqs.
+    5.3-5.4: n finger sets around a drum); copies are named with a set
+    letter, ``4a``, ``4b``, ...; one set keeps the designed names."""
+    if sets == 1:
+        return tuple(fingers)
+    out = []
+    for k in range(sets):
+        phase = 2 * np.pi * k / sets
+        for gf in fingers:
+            out.append(replace(gf, name=f"{gf.name}{'abcdefghijkl'[k]}", family=gf.name,
+                               phase=phase, mount=replace(gf.mount, angle=gf.mount.angle + phase)))
+    return tuple(out)
 
 
 def read_finger_models(reader: Reader, data: dict, field_name: str, base_dir: Path
@@ -205,7 +225,7 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
     atol = reader.quantity(spec, "atol", field_name, "length", lo=1e-14, hi=0.01, default=d.atol)
     max_step = reader.quantity(spec, "max_step", field_name, "time", lo=1e-6, hi=0.1,
                                default=d.max_step)
-    stepper = reader.choice(spec, "stepper", field_name, ("rk45", "dop853"), default=d.stepper)
+    stepper = reader.choice(spec, "stepper", field_name, STEPPERS, default=d.stepper)
     step = reader.quantity(spec, "step", field_name, "time", lo=1e-5, hi=0.1, default=d.step)
     nodes = reader.integer(spec, "contact_nodes", field_name, lo=2, hi=64, default=6)
     reach = reader.boolean(spec, "reach_filter", field_name, default=True)
@@ -213,6 +233,35 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
         return None
     return GraspSettings(IntegratorSettings(integ, rtol, atol, max_step, stepper, step), nodes,
                          reach)
+
+
+MOUNT_FIELDS = ("angle", "phi_x", "phi_y")
+
+
+def _remounted(reader: Reader, grasper: Grasper, value: object) -> Grasper:
+    """The grasper with ``mounts: {finger: {angle|phi_x|phi_y: value}}`` applied
+    to every set's copy of each named (designed) finger; angle is set a's."""
+    names = sorted({gf.design_name for gf in grasper.fingers})
+    spec = reader.mapping(value, "mounts", optional=tuple(value) if isinstance(value, dict) else ())
+    if spec is None:
+        return grasper
+    changes = {}
+    for name, item in spec.items():
+        path = join("mounts", str(name))
+        if str(name) not in names:
+            reader.add(path, f"the grasper has no finger '{name}' (it has {', '.join(names)})")
+            continue
+        fields = reader.mapping(item, path, optional=MOUNT_FIELDS)
+        if fields is not None:
+            changes[str(name)] = {k: reader.quantity(fields, k, path, "angle", lo=-2 * np.pi,
+                                                     hi=2 * np.pi) for k in fields}
+    fingers = []
+    for gf in grasper.fingers:
+        change = {k: v for k, v in changes.get(gf.design_name, {}).items() if v is not None}
+        if "angle" in change:
+            change["angle"] += gf.phase
+        fingers.append(replace(gf, mount=replace(gf.mount, **change)) if change else gf)
+    return replace(grasper, fingers=tuple(fingers))
 
 
 def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspScene | None:
@@ -237,10 +286,12 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
     duration = reader.quantity(data, "duration", "", "time", lo=0.0, lo_open=True, hi=60.0)
     finger_model = reader.choice(data, "finger_model", "", FINGER_MODELS, default="planar")
     settings = read_grasp_settings(reader, data, "solver")
+    if grasper is not None and "mounts" in data:
+        grasper = _remounted(reader, grasper, data["mounts"])
     if grasper is not None and models:
         grasper = replace(grasper, fingers=tuple(
-            replace(gf, finger=Finger(gf.finger.length, models[gf.group].stiffness,
-                                      models[gf.group].name)) if gf.group in models else gf
+            replace(gf, finger=replace(models[gf.group], length=gf.finger.length))
+            if gf.group in models else gf
             for gf in grasper.fingers))
         unknown = set(models) - {gf.group for gf in grasper.fingers}
         for group in sorted(unknown):

@@ -24,7 +24,7 @@ KINDS = {
     "contact": (("finger", "drum", "finger_angle", "object", "friction"),
                 ("sliding", "motion", "solver"), read_contact),
     "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
-              ("finger_models", "friction", "legs", "finger_model", "solver"), read_grasp),
+              ("finger_models", "mounts", "friction", "legs", "finger_model", "solver"), read_grasp),
     "design": (("scene", "variables"), ("cap", "rules", "solver"), read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)

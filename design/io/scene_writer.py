@@ -10,12 +10,25 @@ from design.solve.grasp.simulation import GraspSetup
 
 
 def finger_spec(finger: Finger) -> dict:
-    """An inline finger model (SI) for a scene file."""
+    """An inline finger model (SI) for a scene file, with its out-of-plane
+    rigidities when they are not the round section's defaults."""
     d = dict(finger.stiffness.describe())
     kind = d.pop("type")
     if kind == "uniform":
-        return {"length": finger.length, "EI": d["EI"]}
-    return {"length": finger.length, "E": d.pop("E"), "I": {"type": kind, **d}}
+        out = {"length": finger.length, "EI": d["EI"]}
+        out.update({key: st.describe()["EI"] for key, st in
+                    (("EI_out", finger.stiff), ("GJ", finger.torsion)) if st is not None})
+        return out
+    E = d.pop("E")
+    out = {"length": finger.length, "E": E, "I": {"type": kind, **d}}
+    for key, st in (("I_out", finger.stiff), ("J", finger.torsion)):
+        if st is not None:
+            p = dict(st.describe())
+            modulus = p.pop("E")
+            out[key] = {"type": p.pop("type"), **p}
+            if key == "J":
+                out["poisson"] = E / (2 * modulus) - 1
+    return out
 
 
 def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, description: str) -> dict:
@@ -41,6 +54,7 @@ def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, descriptio
         "friction": {"finger": setup.finger_friction, "conveyor": setup.conveyor_friction},
         "legs": {"stiffness": setup.legs.stiffness, "damping": setup.legs.damping},
         "duration": setup.duration,
+        "finger_model": setup.finger_model,
         "solver": {"integrator": i.integrator, "rtol": i.rtol, "atol": i.atol,
                    "max_step": i.max_step, "stepper": i.stepper, "step": i.step,
                    "contact_nodes": settings.contact_nodes,

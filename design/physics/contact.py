@@ -102,6 +102,11 @@ class ContactSolution:
         return self.pose.vector_to_world(self.force_on_object_finger_frame)
 
     @property
+    def shape_points(self) -> np.ndarray:
+        """The whole finger in its frame (3, n), z = 0: the planar finger stays in its plane."""
+        return np.vstack([self.shape_x, self.shape_y, np.zeros_like(self.shape_x)])
+
+    @property
     def point_world(self) -> np.ndarray:
         return self.pose.to_world(*self.point)[:, 0]
 

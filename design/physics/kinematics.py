@@ -1,5 +1,5 @@
 """The grasper in 3-D: drums, finger frames, and the bird's ellipsoid cut by a
-finger's bending plane (thesis ch. IV, appendix B; MODEL.md §4).
+finger's bending plane (thesis ch. IV, appendix B; docs/MODEL.md).
 
 World frame Cw: origin on the conveyor surface midway between the two drum
 axes, X along the conveyor's motion, Z up, Y towards the left drum. The
@@ -13,25 +13,22 @@ height h along the axis. Its frame Cf3 is built by active rotations
     R = R_tilt · R_z(φ) · R_y(φ_y) · R_x(φ_x)
 
 where R_tilt tilts the drum axis from vertical about the world Y axis. The
-columns of R are the finger's x (the undeformed finger), y (the direction it
-bends in) and z (the direction it is rigid in). With φ_x = φ_y = 0 the finger
+columns of R are the finger's x (the undeformed finger), y (its soft bending
+direction; the planar model's plane is x-y) and z (its stiff direction). With φ_x = φ_y = 0 the finger
 is radial and horizontal and bends in the horizontal plane, as in ch. III;
 φ_y > 0 tilts it downwards (tip below base), φ_x = 90° turns its bending
 plane vertical.
 
-The thesis's Table 5-1 does not fix its angle origin or senses in the
-extracted text. Read as the mirror-image drum, φ = -φ_i - 37.5°,
-φ_x = -φ_x(thesis), φ_y as printed, its
-lower fingers (φ_y = +15°) slide under the bird's belly and the upper ones
-(φ_y = -15°) pass over its back, the middle lower finger faces the bird as
-its centre crosses the drum axis (Table 5-3's timing), and the simulation
-shows what the thesis describes (hard lower fingers hold longer; peak force
-at fingers 3-4 of 14-19 N against "about 11 N"). The other readings tried
-(the other signs of φ_x and φ_y, phases ±20°) flip the bird or press it
-down; see models/graspers/thesis_table_5_1.yaml.
+The convention is the thesis's own (docs/MODEL.md, "Finger layout"): φ is
+chapter III's angular position ("ωt": 126° for Case 1 with the object
+upstream, 180° at the start of the Table 3-4 pass), measured from the
+conveyor's direction towards the bird; φ_y then φ_x are the rotations of
+eq. B.21, [R3] = Rz^T Ry^T Rx^T with the passive matrices of eqs.
+B.16a-B.18a, i.e. the active product above. Table 5-1's values enter as
+printed.
 
-The right drum turns clockwise seen from above, φ(t) = φ_i - ω t: on the bird's
-side its fingers move downstream with the conveyor.
+The right drum turns clockwise seen from above, φ(t) = φ_i - ω t: on the
+bird's side its fingers move downstream with the conveyor (§1.2, §4.3.3).
 """
 
 from __future__ import annotations

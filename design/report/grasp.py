@@ -17,7 +17,9 @@ def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
             ("peak finger force", s["max_finger_force_N"], "N"),
             ("finger with the peak", s["max_finger_force_finger"], ""),
             ("time of the peak", s["max_finger_force_time_s"], "s"),
-            ("centre rise", s["max_lift_m"], "m"), ("lowest point lift", s["max_gap_m"], "m"),
+            ("centre rise (from its start)", s["centre_rise_m"], "m"),
+            ("lowest point above the belt", s["belt_clearance_m"], "m"),
+            ("least belt normal force", s["min_normal_force_N"], "N"),
             ("largest pitch", abs(s["max_pitch_rad"]), "rad")]
     return [{"quantity": q, **({"run": label} if label else {}), "value": v, "unit": u}
             for q, v, u in rows]

@@ -10,14 +10,13 @@ from design.io.files import TOOLKIT_ROOT
 from design.io.fingers import read_finger
 from design.io.grasp_scene import read_bird, read_conveyor, read_grasper
 from design.io.reader import Reader
-from design.physics.beam import Finger
 from design.physics.bird import Legs
 from design.solve.grasp.simulation import GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
 OMEGA = 20 * 2 * np.pi / 60
 #: Table 5-3 (mean bird), 5-4 (football) and 5-5 (bird sizes) starts, m
-MEAN_START, FOOTBALL_START, SIZES_START = -0.457, -0.305, -0.381
+MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
 
 
 def load_model(kind_reader, *path):
@@ -32,7 +31,7 @@ def with_lower(grasper, finger_file: str):
     """The grasper with every lower finger in another finger model's stiffness."""
     model = load_model(read_finger, "fingers", finger_file)
     return replace(grasper, fingers=tuple(
-        replace(f, finger=Finger(f.finger.length, model.stiffness, model.name))
+        replace(f, finger=replace(model, length=f.finger.length))
         if f.group == "lower" else f for f in grasper.fingers))
 
 
@@ -65,8 +64,8 @@ def _line(name: str, run, belt_end: float | None = None) -> str:
     x_end = run.trajectory.records[-1].y[0]
     windows = ", ".join(f"{a:.3f}-{b:.3f}" for a, b in s["hold_windows"]) or "none"
     return (f"| {name} | {windows} | {s['hold_time_s']:.3f} | {s['max_finger_force_N']:.1f} "
-            f"(finger {s['max_finger_force_finger']}) | {1e3 * s['max_lift_m']:.1f} | "
-            f"{1e3 * s['max_gap_m']:.1f} | {abs(s['max_pitch_rad']) * 180 / np.pi:.0f} | "
+            f"(finger {s['max_finger_force_finger']}) | {1e3 * s['centre_rise_m']:.1f} | "
+            f"{1e3 * s['belt_clearance_m']:.1f} | {abs(s['max_pitch_rad']) * 180 / np.pi:.0f} | "
             f"{x_end:+.3f} |")
 
 
@@ -133,14 +132,14 @@ def markdown(runs: dict | None = None) -> str:
               f"{hard.summary['max_finger_force_finger']} (hard) and "
               f"{soft.summary['max_finger_force_N']:.1f} N (soft). The thesis reports mean birds "
               f"lifted to about 80 mm; our centre rises "
-              f"{1e3 * hard.summary['max_lift_m']:.0f} mm. The lower fingers reach the "
+              f"{1e3 * hard.summary['centre_rise_m']:.0f} mm. The lower fingers reach the "
               f"conveyor's centre line (drum radius + finger = half the drum spacing), so in a "
               f"quasi-static elastica model they must bend far around a 132 mm wide bird; the "
               f"thesis computed its forces with Algorithm I's uniform stand-in, whose contact "
               f"point we found 16-25 mm from the non-uniform finger's (contact report).",
               f"* Football (Table 5-4, Figures 5-13/5-14): the thesis measured a rise of about "
-              f"18 mm. Ours rises {1e3 * fb.summary['max_lift_m']:.0f} mm at the centre, "
-              f"{1e3 * fb.summary['max_gap_m']:.0f} mm at its lowest point, and then tumbles: "
+              f"18 mm. Ours rises {1e3 * fb.summary['centre_rise_m']:.0f} mm at the centre, "
+              f"{1e3 * fb.summary['belt_clearance_m']:.0f} mm at its lowest point, and then tumbles: "
               f"the long finger 5 reaches the light ball's side first and kicks it backwards "
               f"(X at 2 s: {fb.trajectory.records[-1].y[0]:+.2f} m). A pitch-only rigid "
               f"ellipsoid with no rolling resistance cannot stop tumbling once turned over; the "

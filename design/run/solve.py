@@ -106,7 +106,11 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
                   "baseline": v.baseline, "optimum": v.lo + d[i] * (v.hi - v.lo),
                   "active_bound": "lower" if d[i] < ACTIVE else "upper" if d[i] > 1 - ACTIVE
                   else ""} for i, v in enumerate(space.variables)]
-    if check["passed"]:
+    if check["passed"] and check["model_warnings"]:
+        status = "verified by a model outside its validity"
+        message = ("the independent simulation confirms the design, but the grasp model is "
+                   "outside its validity: " + "; ".join(check["model_warnings"]))
+    elif check["passed"]:
         status, message = "verified", "the independent simulation confirms the design"
     elif not outcome.feasible:
         status = "infeasible"

@@ -216,18 +216,24 @@ class SpatialContact:
                                               "pose", converged=False), None
         if segment_level(quadric, length) >= 0.0:
             return no_spatial_contact(length, "the straight finger misses the object"), None
-        msg = ""
+        # the geometry first, under the friction it had; then the friction
         if previous is not None:
-            state, msg = self._continue(previous, quadric, friction)
+            state, msg = self._continue(previous, quadric, previous.friction)
             if state is None and msg != BASE_REACHED:
-                state, msg2 = self._from_grazing(quadric, friction)
+                state, msg2 = self._from_grazing(quadric, np.zeros(3))
                 msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
                       f"first touch" if state is not None else msg2
         else:
-            state, msg = self._from_grazing(quadric, friction)
+            state, msg = self._from_grazing(quadric, np.zeros(3))
         if state is None:
             return no_spatial_contact(length, msg, converged=False), None
-        return self._solution(state, msg, detail), state
+        state, held = self._apply_friction(state, friction)
+        if held < 1.0:
+            msg = "; ".join(m for m in (msg, f"sticking: the finger carries {held:.0%} of the "
+                                             f"sliding friction (no equilibrium beyond)") if m)
+        sol = self._solution(state, msg, detail)
+        sol.extras["friction_held"] = held
+        return sol, state
 
     def sliding_velocity(self, state: SpatialState, kin: Kinematics) -> np.ndarray:
         """The finger's material point at the contact relative to the object's
@@ -253,6 +259,29 @@ class SpatialContact:
     def _params(self, quadric: Quadric, friction: np.ndarray) -> np.ndarray:
         return np.concatenate([[self.finger.length, self.ei_ref], quadric.params, friction,
                                self.widths, self.stiffness.params])
+
+    def _apply_friction(self, state: SpatialState, friction: np.ndarray
+                        ) -> tuple[SpatialState, float]:
+        """Continue ``state`` from its friction vector to ``friction``; where the
+        equilibrium ends before (a fold: the sliding friction would drag the
+        contact off), stop at the last equilibrium. Its friction is a convex
+        combination of two vectors inside the Coulomb cone, so it is inside
+        too: the contact sticks there. Returns the state and the fraction of
+        the change carried."""
+        if np.array_equal(state.friction, friction):
+            return state, 1.0
+        start = state.friction
+        t, step = 0.0, 1.0
+        for _ in range(self.max_steps):
+            if t >= 1.0 or step < 1e-3:
+                break
+            t_new = min(1.0, t + step)
+            new = self._step(state, state.quadric, start + t_new * (friction - start))
+            if isinstance(new, SpatialState):
+                state, t, step = new, t_new, min(2 * step, 1.0)
+            else:
+                step /= 2
+        return state, t
 
     def _from_grazing(self, quadric: Quadric, friction: np.ndarray):
         graze = grazing_shift(quadric, self.finger.length)

@@ -21,13 +21,13 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import DOP853, RK45
+from scipy.integrate import DOP853, RK45, Radau
 from scipy.optimize import brentq
 
 from design.physics.bird import BirdDynamics, Conveyor, Loads
 from design.solve.grasp.fingers import ContactFailed, FingerForces, FingerState
 
-STEPPERS = {"dop853": DOP853, "rk45": RK45}
+STEPPERS = {"dop853": DOP853, "rk45": RK45, "radau": Radau}
 INTEGRATORS = ("adaptive", "bdf4")
 
 

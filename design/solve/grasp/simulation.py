@@ -11,6 +11,7 @@ from design.physics.bird import Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
 from design.solve.grasp.fingers import FingerForces, reach_windows
 from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, integrate
+from design.solve.grasp.validity import contact_validity
 
 
 @dataclass(frozen=True)
@@ -118,6 +119,7 @@ def summarise(run: GraspRun) -> dict:
     z = np.array([r.y[1] for r in recs])
     gap = z - np.array([BirdDynamics(run.setup.bird, run.setup.legs, 0.0).support(r.y[2])[1]
                         for r in recs])
+    validity = contact_validity(run)
     return {
         "hold_windows": [[a, b] for a, b in windows],
         "hold_time_s": max((b - a for a, b in windows), default=0.0),
@@ -126,9 +128,12 @@ def summarise(run: GraspRun) -> dict:
         "max_finger_force_finger": names[j],
         "max_finger_force_time_s": recs[k].t,
         "max_force_per_finger_N": {n: float(v) for n, v in zip(names, force.max(axis=0))},
-        "max_lift_m": float(z.max() - z[0]),
-        "max_gap_m": float(gap.max()),
+        "centre_rise_m": float(z.max() - z[0]),
+        "belt_clearance_m": float(gap.max()),
         "max_pitch_rad": float(np.max(np.abs([r.y[2] for r in recs]))),
+        "min_normal_force_N": float(min(r.normal for r in recs)),
+        "finger_model": run.setup.finger_model,
+        "validity": validity,
         "events": [[t, name] for t, name in run.trajectory.events],
         "ok": run.trajectory.ok,
         "message": run.trajectory.message,

@@ -141,8 +141,9 @@ class DesignNLP:
             if c is None:
                 continue
             gf = grasper.fingers[i]
-            key = f"fingers.{gf.name}."
-            fp = ca.vertcat(values[key + "angle"], values[key + "height"], gf.mount.radius,
+            key = f"fingers.{gf.design_name}."
+            fp = ca.vertcat(values[key + "angle"] + gf.phase, values[key + "height"],
+                            gf.mount.radius,
                             values[key + "phi_x"], values[key + "phi_y"], values[key + "length"])
             scale = values[f"groups.{gf.group}.stiffness_scale"]
             out = self.fingers[i].functions[c.mode](y[:3], t, fp, g, scale, c.tau_mu, c.z)
@@ -353,9 +354,9 @@ def rule_margins(values: dict, setup, rules: Rules) -> list:
     """(margin ≥ 0 when the rule holds, name) of the design rules, numbers or
     CasADi expressions as the values are."""
     out = [(values["spacing"] - setup.bird.lam - rules.sigma_lambda, "rule 5.7: d >= lambda")]
-    for gf in setup.grasper.fingers:
-        out.append((values["spacing"] - values[f"fingers.{gf.name}.length"],
-                    f"rule 5.7: d >= l ({gf.name})"))
+    for name in dict.fromkeys(gf.design_name for gf in setup.grasper.fingers):
+        out.append((values["spacing"] - values[f"fingers.{name}.length"],
+                    f"rule 5.7: d >= l ({name})"))
     if rules.bird_spacing is not None:
         ratio = rules.finger_sets * rules.bird_spacing / (2 * np.pi)
         gap = setup.conveyor.speed / values["drum_speed"] - ratio

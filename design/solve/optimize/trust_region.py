@@ -37,6 +37,7 @@ import numpy as np
 
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import GraspRun, simulate_grasp
+from design.solve.grasp.validity import validity_problems
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPResult, NLPSettings, Rules
 from design.solve.optimize.variables import DesignSpace
@@ -284,4 +285,5 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
             "cap_N": cap, "optimiser_hold_time_s": nlp_hold,
             "hold_time_relative_difference": hold_error,
             "hold_tolerance": HOLD_TOLERANCE, "cap_tolerance": CAP_TOLERANCE,
+            "model_warnings": validity_problems(s["validity"]),
             "passed": bool(passed)}

@@ -20,9 +20,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from design.physics.beam import Finger
 from design.physics.bird import Conveyor
-from design.physics.grasper import GraspFinger
 from design.physics.kinematics import FingerMount
 from design.solve.grasp.simulation import GraspSetup
 
@@ -67,10 +65,10 @@ def parameters_of(setup: GraspSetup) -> dict[str, float]:
     """Every parameter of a grasp, by name (SI). The conveyor must be timed."""
     values: dict[str, float] = {}
     for gf in setup.grasper.fingers:
-        m = gf.mount
-        values.update({f"fingers.{gf.name}.angle": m.angle, f"fingers.{gf.name}.phi_x": m.phi_x,
-                       f"fingers.{gf.name}.phi_y": m.phi_y, f"fingers.{gf.name}.height": m.height,
-                       f"fingers.{gf.name}.length": gf.finger.length})
+        m, key = gf.mount, f"fingers.{gf.design_name}."
+        values.update({key + "angle": m.angle - gf.phase, key + "phi_x": m.phi_x,
+                       key + "phi_y": m.phi_y, key + "height": m.height,
+                       key + "length": gf.finger.length})
     for group in groups(setup):
         values[f"groups.{group}.stiffness_scale"] = 1.0
     c = setup.conveyor
@@ -132,13 +130,13 @@ def apply(setup: GraspSetup, values: dict) -> GraspSetup:
     """The grasp with these parameter values (SI)."""
     fingers = []
     for gf in setup.grasper.fingers:
-        key = f"fingers.{gf.name}."
+        key = f"fingers.{gf.design_name}."
         scale = values[f"groups.{gf.group}.stiffness_scale"]
-        stiffness = gf.finger.stiffness if scale == 1.0 else gf.finger.stiffness.scaled(scale)
-        mount = FingerMount(values[key + "angle"], values[key + "height"], gf.mount.radius,
-                            values[key + "phi_x"], values[key + "phi_y"])
-        fingers.append(GraspFinger(gf.name, Finger(values[key + "length"], stiffness,
-                                                   gf.finger.name), mount, gf.group))
+        finger = gf.finger if scale == 1.0 else gf.finger.scaled(scale)
+        mount = FingerMount(values[key + "angle"] + gf.phase, values[key + "height"],
+                            gf.mount.radius, values[key + "phi_x"], values[key + "phi_y"])
+        fingers.append(replace(gf, finger=replace(finger, length=values[key + "length"]),
+                               mount=mount))
     grasper = replace(setup.grasper, fingers=tuple(fingers), spacing=values["spacing"])
     c = setup.conveyor
     conveyor = Conveyor(c.speed, values["conveyor.final_speed"], values["conveyor.rate"],

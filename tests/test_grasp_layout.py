@@ -1,0 +1,114 @@
+"""The thesis's grasper layout read in its own convention (models/graspers/
+thesis_table_5_1.yaml, docs/MODEL.md "Finger layout"): each test states one of
+the thesis's geometric facts and checks the straight (undeflected) fingers
+against it. No dynamics: these pin the convention, not the model."""
+
+import numpy as np
+import pytest
+
+from design.io.scene import check_file
+from design.physics.kinematics import Ellipsoid
+
+GRASPER = check_file("models/graspers/thesis_table_5_1.yaml")
+OMEGA = 20 * 2 * np.pi / 60           # 20 rpm (Tables 5-3, 5-4)
+DRUM = GRASPER.drum(OMEGA)
+
+
+def finger(name: str):
+    return next(gf for gf in GRASPER.fingers if gf.name == name)
+
+
+def axis(name: str, t: float = 0.0) -> np.ndarray:
+    return DRUM.frame(finger(name).mount, t)[1][:, 0]
+
+
+def test_three_sets_repeat_every_one_second_cycle():
+    """Eq. 5.3, v/ω = n Δx / 2π, with the one-second cycle of §5.3 (Δx = 0.457 m
+    at 0.457 m/s, 20 rpm): n = 3 sets, so set b one cycle later stands where
+    set a stood."""
+    assert 2 * np.pi * 0.457 / (OMEGA * 0.457) == pytest.approx(3.0, rel=1e-3)
+    assert GRASPER.sets == 3 and len(GRASPER.fingers) == 15
+    for name in "12345":
+        base_a, R_a = DRUM.frame(finger(name + "a").mount, 0.0)
+        base_b, R_b = DRUM.frame(finger(name + "b").mount, 1.0)
+        np.testing.assert_allclose(base_b, base_a, atol=2e-3)    # 20 rpm is 2.0944 rad/s
+        np.testing.assert_allclose(R_b, R_a, atol=2e-2)
+
+
+def test_finger_3_faces_the_bird_at_90_degrees():
+    """§5.1: a finger's fixed axis is parallel to y_b when φ_i + ωt = π/2.
+    Finger 3 (90°) at t = 0 points across the conveyor, at the bird's side."""
+    a = axis("3a")
+    horizontal = a[:2] / np.hypot(*a[:2])
+    np.testing.assert_allclose(horizontal, [0.0, 1.0], atol=1e-12)
+
+
+def test_the_bird_side_of_the_drum_moves_downstream():
+    """§1.2, §4.3.3: the drum turns clockwise; on the bird's side its fingers move
+    with the conveyor (+X), as in chapter III's pass (180° down to 0°)."""
+    mount = finger("3a").mount
+    tip = lambda t: DRUM.frame(mount, t)[0] + 0.076 * DRUM.frame(mount, t)[1][:, 0]  # noqa: E731
+    assert (tip(1e-4) - tip(0.0))[0] > 0
+
+
+def test_finger_5_trails_behind_the_legs():
+    """§5.1: two lower fingers hold the breast, the third is behind the leg. The
+    lower fingers reach the bird's side in the order 3, 4, 5 (the set sweeps
+    downstream with 5 last), upper 1 before 2."""
+    def crossing(name):        # time at which the finger is perpendicular to the belt
+        return (finger(name).mount.angle - np.pi / 2) / OMEGA
+    assert crossing("3a") < crossing("4a") < crossing("5a")
+    assert crossing("1a") < crossing("2a")
+
+
+def test_upper_fingers_tip_up_and_lower_ones_tip_down():
+    """φ_y < 0 for the upper fingers and > 0 for the lower ones (eq. B.17,
+    positive φ_y about y tips x down): the lower fingers reach under the
+    belly, the upper ones over the back."""
+    for name in "12":
+        assert axis(name + "a")[2] > 0
+    for name in "345":
+        assert axis(name + "a")[2] < 0
+
+
+def test_bending_planes():
+    """Finger 4 (φ_x = 90°) bends in a vertical plane; finger 3 (φ_x = 45°)
+    lifts only by pushing upstream and finger 5 (φ_x = -45°) by pushing
+    downstream, when they face the bird: §5.3 says finger 3 below 60° pushes
+    the football back."""
+    def bending(name):
+        m = finger(name).mount
+        t = (m.angle - np.pi / 2) / OMEGA          # facing the bird
+        return DRUM.frame(m, t)[1][:, 1]
+    y4 = bending("4a")
+    assert abs(y4[2]) > 0.99
+    for name, sign in (("3a", -1), ("5a", 1)):
+        y = bending(name)
+        up = y if y[2] > 0 else -y                 # the in-plane direction that lifts
+        assert np.sign(up[0]) == sign
+
+
+def reached_fingers(x0: float, duration: float) -> set[str]:
+    """Designed fingers whose straight copies enter the resting mean bird
+    (Table 5-3) carried from X0 at 0.457 m/s, sampled every millisecond."""
+    reached = set()
+    for k in range(int(round(duration * 1e3)) + 1):
+        t = k * 1e-3
+        bird = Ellipsoid(0.097, 0.066, 0.057, (x0 + 0.457 * t, 0.0, 0.057))
+        for gf in GRASPER.fingers:
+            base, R = DRUM.frame(gf.mount, t)
+            pts = base[:, None] + np.outer(R[:, 0], np.linspace(0, gf.finger.length, 60))
+            if np.min(bird.level(pts)) < 0:
+                reached.add(gf.design_name)
+    return reached
+
+
+def test_finger_3_misses_the_mean_bird_only_with_table_5_3s_metres():
+    """§5.2, Figs 5-7 and 5-8: no contact between finger 3 and the mean bird.
+    Table 5-3 prints X0 as "-0.075 (-18)": with -0.075 m at t = 0 (the bird
+    reaches X = +0.15 m in Fig 5-5's 0.5 s, the range of Figs 5-7 and 5-9) the
+    straight finger 3 never enters the resting bird while finger 4 does; with
+    -18 in = -0.457 m (the bird at the drum axis when set b stands at the
+    table's angles) finger 3 cuts through it."""
+    assert reached_fingers(-0.075, 0.5) >= {"4"} and "3" not in reached_fingers(-0.075, 0.5)
+    assert "3" in reached_fingers(-0.457, 1.5)
