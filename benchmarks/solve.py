@@ -1,6 +1,6 @@
 """The design NLP: how its cost grows with the time grid and the finger mesh.
 
-For problems/hold_time.yaml (mean bird, Figure 5-10 belt, 8 variables) at
+For problems/hold_time.yaml (mean bird of Table 5-3, 8 variables) at
 three (time step, beam intervals) sizes: the NLP built around the baseline's
 simulated schedule with the first trust region (half-width 0.15), its size
 (variables, constraints, Jacobian nonzeros, finger-contact stages), the

@@ -1,10 +1,12 @@
 """Optimal design and timing of compliant graspers.
 
 The package's API: :func:`simulate` solves a scene file (or its content),
-:func:`check` validates one. The command ``design`` wraps both.
+:func:`check` validates a file, :func:`design.api.solve` optimises a design
+problem (``design.solve`` is the solvers' subpackage). The command ``design``
+wraps them.
 """
 
-import os
+import os as _os
 
 __version__ = "0.1.0"
 
@@ -12,7 +14,7 @@ __version__ = "0.1.0"
 # contend for the cores. Measured on 2 busy cores, the Table 3-4 contact pass
 # took 4.4 s with OpenBLAS's default threads and 2.6 s with one. A user's own
 # setting wins; it has no effect if numpy was imported before this package.
-os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+_os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 from design.api import check, simulate  # noqa: E402
 

@@ -11,6 +11,7 @@ import sys
 from pathlib import Path
 
 from design.errors import ProblemFileError
+from design import __version__
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
 
@@ -93,6 +94,7 @@ def _lazy(module: str, name: str):
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog="design", description="Optimal design and timing of compliant graspers.")
+    parser.add_argument("--version", action="version", version=f"design {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
     p = sub.add_parser("simulate", help="solve a scene file and write its results")
     p.add_argument("scene", help="scene file (YAML)")

@@ -54,3 +54,18 @@ def test_console_command_is_installed():
     done = subprocess.run([*cmd, "check", str(ROOT / "problems" / "beam_table_2_1.yaml")],
                           capture_output=True, text=True, timeout=120)
     assert done.returncode == 0 and "OK" in done.stdout
+
+
+def test_the_documented_api_is_callable_and_the_version_is_shown(capsys):
+    """README's Python calls exist as documented (`from design.api import
+    solve`, `design.simulate`, `design.check`); `design --version` prints the
+    package's version."""
+    import design
+    from design.api import solve
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    assert "from design.api import solve" in readme and "design.solve(" not in readme
+    assert callable(solve) and callable(design.simulate) and callable(design.check)
+    assert "os" not in dir(design)
+    with pytest.raises(SystemExit) as exit_:
+        main(["--version"])
+    assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"design {design.__version__}"

@@ -3,6 +3,7 @@ differences, a one-variable problem against exhaustive search, and the
 verification that must catch a design breaking the cap."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -10,6 +11,7 @@ import pytest
 from design.cli import main
 from design.io.grasp_scene import GraspSettings
 from design.io.scene_writer import grasp_spec
+from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPSettings
 from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, simulate,
@@ -158,3 +160,23 @@ def test_a_stalled_view_stops_and_a_converging_one_does_not():
     assert not stalled([1.0, 0.5, 0.1] + list(np.geomspace(0.09, 0.02, 15)))   # still gaining
     assert not stalled([1.0, 0.5, 1e-3] + [1e-3] * 15)    # feasible: the objective may move
     assert not stalled(flat, n=0)                          # rule off
+
+
+def test_a_baseline_that_turns_the_bird_over_is_refused_by_name():
+    """The mean bird from X0 = -0.457 m on the Figure 5-10 belt: the planar
+    baseline tumbles it (pitch about -3 rad). The NLP, which keeps |pitch| <=
+    1.5 rad, must say so rather than fail inside Ipopt on a clipped start."""
+    from design.reproduce.grasp import thesis_setup
+    from design.solve.optimize.transcription import MAX_PITCH
+    from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
+
+    setup = thesis_setup(0.0, 1.6, "hard", start=-0.457,
+                         conveyor_file="decelerate_figure_5_10.yaml")
+    slows = [t for t, name in simulate_grasp(setup).trajectory.events if name == "belt slows"]
+    setup = replace(setup, conveyor=timed_conveyor(setup.conveyor, slows[0]))
+    space = DesignSpace(setup, [Variable("groups.lower.stiffness_scale", 0.5, 2.0, 1.0)])
+    run = simulate(space, space.scale(space.base_values), SETTINGS).run
+    schedule = schedule_of(run, 0.01)
+    assert max(abs(s[2]) for p in schedule.phases for s in p.states) > MAX_PITCH
+    with pytest.raises(ValueError, match="turns over inside the optimiser's window"):
+        DesignNLP(space, schedule, run, 100.0, SETTINGS.nlp)

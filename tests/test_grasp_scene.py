@@ -77,3 +77,20 @@ def test_mounts_change_every_set_of_a_finger():
         design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
                       "mounts": {"9": {"phi_x": "60 deg"}}})
     assert any(p.field == "mounts.9" and "no finger '9'" in p.message for p in err.value.problems)
+
+
+def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):
+    """`solver: {max_wall_time: ...}`: the run stops, exit 1, `ok` false, and
+    the message says where it got to; the records so far are kept."""
+    import json
+
+    scene = {**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
+             "bird": str(ROOT / SCENE["bird"]), "start": {"X": -0.075}, "duration": 0.6,
+             "solver": {"max_wall_time": "0.2 s"}}
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(scene))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1
+    summary = json.loads((tmp_path / "out" / "result.json").read_text())["summary"]
+    assert not summary["ok"] and "wall-time budget of 0.2 s" in summary["message"]
+    t_reached = float(summary["message"].split("at t = ")[1].split(" s")[0])
+    assert 0.0 <= t_reached < 0.6

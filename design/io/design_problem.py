@@ -4,7 +4,7 @@ bounds, the bruise cap, the design rules and the solver settings.
 .. code-block:: yaml
 
     kind: design
-    scene: grasp_mean_bird_figure_5_10.yaml     # a grasp scene file, or its content inline
+    scene: grasp_mean_bird_hard.yaml            # a grasp scene file, or its content inline
     variables:                                  # name: [lower, upper]; the rest stay at baseline
       conveyor.start_time: [0.4 s, 1.2 s]
       conveyor.final_speed: [0.254 m/s, 0.457 m/s]
@@ -122,6 +122,10 @@ def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
         return None
     if not isinstance(scene, GraspScene):
         reader.add("scene", "must be a grasp scene (kind: grasp)")
+        return None
+    if scene.finger_model != "planar":
+        reader.add("scene", f"finger_model '{scene.finger_model}': the optimiser models the "
+                            f"fingers as planar; a design scene must use finger_model: planar")
         return None
     return scene
 

@@ -215,7 +215,7 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
         return GraspSettings()
     spec = reader.mapping(data[field_name], field_name,
                           optional=("integrator", "rtol", "atol", "max_step", "stepper", "step",
-                                    "contact_nodes", "reach_filter"))
+                                    "contact_nodes", "reach_filter", "max_wall_time"))
     if spec is None:
         return None
     d = IntegratorSettings()
@@ -229,10 +229,13 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
     step = reader.quantity(spec, "step", field_name, "time", lo=1e-5, hi=0.1, default=d.step)
     nodes = reader.integer(spec, "contact_nodes", field_name, lo=2, hi=64, default=6)
     reach = reader.boolean(spec, "reach_filter", field_name, default=True)
-    if None in (integ, rtol, atol, max_step, stepper, step, nodes, reach):
+    budget = reader.quantity(spec, "max_wall_time", field_name, "time", lo=0.0, lo_open=True,
+                             default=None) if "max_wall_time" in spec else None
+    if None in (integ, rtol, atol, max_step, stepper, step, nodes, reach) or \
+            ("max_wall_time" in spec and budget is None):
         return None
-    return GraspSettings(IntegratorSettings(integ, rtol, atol, max_step, stepper, step), nodes,
-                         reach)
+    return GraspSettings(IntegratorSettings(integ, rtol, atol, max_step, stepper, step, budget),
+                         nodes, reach)
 
 
 MOUNT_FIELDS = ("angle", "phi_x", "phi_y")

@@ -58,7 +58,8 @@ def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, descriptio
         "solver": {"integrator": i.integrator, "rtol": i.rtol, "atol": i.atol,
                    "max_step": i.max_step, "stepper": i.stepper, "step": i.step,
                    "contact_nodes": settings.contact_nodes,
-                   "reach_filter": settings.reach_filter},
+                   "reach_filter": settings.reach_filter,
+                   **({"max_wall_time": i.max_wall_time} if i.max_wall_time else {})},
     }
 
 

@@ -40,7 +40,7 @@ def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
          lambda progress: contact_rows.sections(contact_rows.compute())),
     ]
     if not quick:
-        chapters.append(("chapter V: grasp figures (14 runs, a minute or two)",
+        chapters.append(("chapter V: grasp figures (16 runs, most with the spatial finger model)",
                          lambda progress: grasp_rows.sections(grasp_rows.compute(progress))))
     return chapters
 
@@ -60,7 +60,7 @@ def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[st
             progress(f"{name}: {time.perf_counter() - t0:.1f} s")
     if quick:
         sections.append(Section("grasp", grasp_rows.TITLE, "Skipped (--quick): the grasp runs "
-                                "take a minute or two; run 'design reproduce' without --quick.",
+                                "take tens of minutes; run 'design reproduce' without --quick.",
                                 []))
     return sections, failures
 

@@ -17,6 +17,12 @@ MODELS = TOOLKIT_ROOT / "models"
 OMEGA = 20 * 2 * np.pi / 60
 #: Table 5-3 (mean bird), 5-4 (football) and 5-5 (bird sizes) starts, m
 MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
+#: the finger model the chapter V comparisons use: the bird's surface normal
+#: at the contacts lies up to 0.8-0.97 along the fingers' stiff axes, beyond
+#: the planar model's limit (design/solve/grasp/validity.py)
+VALIDATION_MODEL = "spatial"
+#: Table 5-1 angles hold for set a at t = 0; Table 5-3's 0.6 s covers set a's grasp
+MEAN_DURATION, FOOTBALL_DURATION = 0.6, 1.6
 
 
 def load_model(kind_reader, *path):
@@ -27,12 +33,21 @@ def load_model(kind_reader, *path):
     return model
 
 
-def with_lower(grasper, finger_file: str):
-    """The grasper with every lower finger in another finger model's stiffness."""
+def with_lower(grasper, finger_file: str, groups: tuple[str, ...] = ("lower",)):
+    """The grasper with every finger of ``groups`` in another finger model."""
     model = load_model(read_finger, "fingers", finger_file)
     return replace(grasper, fingers=tuple(
         replace(f, finger=replace(model, length=f.finger.length))
-        if f.group == "lower" else f for f in grasper.fingers))
+        if f.group in groups else f for f in grasper.fingers))
+
+
+def with_phi_x(setup: GraspSetup, family: str, degrees: float) -> GraspSetup:
+    """The setup with every set's copy of finger ``family`` at φx = ``degrees``
+    (Table 5-1's sense, as the grasper file uses it)."""
+    g = setup.grasper
+    return replace(setup, grasper=replace(g, fingers=tuple(
+        replace(f, mount=replace(f.mount, phi_x=np.radians(degrees)))
+        if f.design_name == family else f for f in g.fingers)))
 
 
 def advanced(grasper, t_skip: float, omega: float = OMEGA):
@@ -45,7 +60,7 @@ def advanced(grasper, t_skip: float, omega: float = OMEGA):
 def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard",
                  bird_file: str = "mean_1_80kg.yaml", start: float = MEAN_START,
                  conveyor_file: str = "constant_0457.yaml", friction: float = 0.4,
-                 legs: Legs = Legs()) -> GraspSetup:
+                 legs: Legs = Legs(), finger_model: str = "planar") -> GraspSetup:
     """A bird through the Table 5-1 grasper (hard or soft lower fingers),
     started ``t_skip`` seconds in: fingers advanced by ω t_skip and the bird by
     v t_skip, so that a short run covers the grasp itself (valid while nothing
@@ -56,112 +71,46 @@ def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard"
     bird = load_model(read_bird, "birds", bird_file)
     conveyor = load_model(read_conveyor, "conveyors", conveyor_file)
     return GraspSetup(advanced(grasper, t_skip), bird, conveyor, OMEGA,
-                      start + conveyor.speed * t_skip, friction, friction, legs, duration)
+                      start + conveyor.speed * t_skip, friction, friction, legs, duration,
+                      finger_model)
 
 
-def _line(name: str, run, belt_end: float | None = None) -> str:
-    s = run.summary
-    x_end = run.trajectory.records[-1].y[0]
-    windows = ", ".join(f"{a:.3f}-{b:.3f}" for a, b in s["hold_windows"]) or "none"
-    return (f"| {name} | {windows} | {s['hold_time_s']:.3f} | {s['max_finger_force_N']:.1f} "
-            f"(finger {s['max_finger_force_finger']}) | {1e3 * s['centre_rise_m']:.1f} | "
-            f"{1e3 * s['belt_clearance_m']:.1f} | {abs(s['max_pitch_rad']) * 180 / np.pi:.0f} | "
-            f"{x_end:+.3f} |")
+def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL) -> GraspSetup:
+    """Table 5-3's mean bird from X0 = -0.075 m, constant belt, µ = 0.4; lower
+    fingers ``hard``, ``soft`` or ``constant`` (every finger EI = 0.08 N m²)."""
+    s = thesis_setup(0.0, MEAN_DURATION, "hard" if lower == "constant" else lower,
+                     finger_model=model)
+    if lower == "constant":
+        s = replace(s, grasper=with_lower(s.grasper, "thesis_uniform.yaml", ("upper", "lower")))
+    return s
 
 
-def football_setup(start: float = FOOTBALL_START) -> GraspSetup:
-    """The Table 5-4 football (µ = 1.16) on the Figure 5-10 decelerating belt,
-    started at ``start`` (m)."""
-    return thesis_setup(0.0, 2.0, "hard", "football.yaml", start, "decelerate_figure_5_10.yaml",
-                        1.16)
+def football_setup(start: float = FOOTBALL_START, friction: float = 1.16,
+                   phi_x3: float = 60.0, model: str = VALIDATION_MODEL) -> GraspSetup:
+    """The Table 5-4 football on the Figure 5-10 belt from ``start`` (m): finger
+    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs."""
+    s = thesis_setup(0.0, FOOTBALL_DURATION, "hard", "football.yaml", start,
+                     "decelerate_figure_5_10.yaml", friction, Legs(0.0, 0.0), model)
+    return with_phi_x(replace(s, conveyor_friction=1.16), "3", phi_x3)
 
 
-def scenario_setups() -> dict[str, GraspSetup]:
-    """The chapter V runs' setups, by name."""
-    fb = football_setup()
-    setups = {
-        "mean bird, hard lower fingers": thesis_setup(0.0, 2.0, "hard"),
-        "mean bird, soft lower fingers": thesis_setup(0.0, 2.0, "soft"),
-        "football, µ = 1.16": fb,
-        "football, finger µ = 0": replace(fb, finger_friction=0.0),
-    }
-    for bird in ["small_1_20kg", "mean_1_66kg", "mean_1_80kg", "large_2_05kg", "large_2_30kg"]:
-        setups[f"Table 5-5: {bird}"] = thesis_setup(0.0, 2.0, "hard", f"{bird}.yaml",
-                                                    SIZES_START)
-    return setups
+def sizes_setup(bird: str) -> GraspSetup:
+    """A Table 5-5 bird from X0 = -0.381 m, µ = 0.4, on the Figure 5-10 belt
+    (the football studies' profiles; Figure 5-19's X axis starts at -0.25 m)."""
+    return thesis_setup(0.0, FOOTBALL_DURATION, "hard", f"{bird}.yaml", SIZES_START,
+                        "decelerate_figure_5_10.yaml", 0.4, Legs(), VALIDATION_MODEL)
 
 
-def simulate_all(setups: dict[str, GraspSetup], progress=None) -> dict:
-    """Each setup simulated (GraspRun each, by name); ``progress(message)`` is
-    called before each run."""
+def simulate_all(setups: dict[str, GraspSetup], progress=None,
+                 budget: float | None = None) -> dict:
+    """Each setup simulated (GraspRun each, by name), each within ``budget`` s
+    of wall time if given; ``progress(message)`` is called before each run."""
+    from design.solve.grasp.integrate import IntegratorSettings
     from design.solve.grasp.simulation import simulate_grasp
 
     runs = {}
     for k, (name, setup) in enumerate(setups.items(), 1):
         if progress:
             progress(f"grasp run {k}/{len(setups)}: {name}")
-        runs[name] = simulate_grasp(setup)
+        runs[name] = simulate_grasp(setup, IntegratorSettings(max_wall_time=budget))
     return runs
-
-
-def scenarios(progress=None) -> dict:
-    """The chapter V runs, by name (GraspRun each)."""
-    return simulate_all(scenario_setups(), progress)
-
-
-def markdown(runs: dict | None = None) -> str:
-    runs = runs or scenarios()
-    head = ("| run | N = 0 windows (s) | longest (s) | peak finger force (N) | centre rise (mm) | "
-            "lowest point lift (mm) | max pitch (°) | X at 2 s (m) |")
-    lines = ["# Grasp dynamics reproduced (thesis chapter V)", "",
-             "Generated by `python -m design.reproduce.grasp`. Symmetric grasp (MODEL.md §5), "
-             "Table 5-1 grasper read as documented in models/graspers/thesis_table_5_1.yaml, "
-             "default adaptive integrator, legs k = 30 N/m, c = 1.5 N s/m. Two simulated "
-             "seconds from the bird sitting on the belt.", "", head,
-             "|---|---|---|---|---|---|---|---|"]
-    lines += [_line(name, run) for name, run in runs.items()]
-    hard, soft = runs["mean bird, hard lower fingers"], runs["mean bird, soft lower fingers"]
-    fb, fb0 = runs["football, µ = 1.16"], runs["football, finger µ = 0"]
-    small, mean = runs["Table 5-5: small_1_20kg"], runs["Table 5-5: mean_1_80kg"]
-    lines += ["", "## Against the thesis", "",
-              f"* Mean bird, soft against hard lower fingers (Figures 5-5 to 5-9): the thesis "
-              f"finds the hard fingers keep the bird off the belt longer; so do we "
-              f"({hard.summary['hold_time_s']:.3f} s against {soft.summary['hold_time_s']:.3f} s). "
-              f"The thesis's peak finger force is about 11 N, at finger 4; ours is "
-              f"{hard.summary['max_finger_force_N']:.1f} N at finger "
-              f"{hard.summary['max_finger_force_finger']} (hard) and "
-              f"{soft.summary['max_finger_force_N']:.1f} N (soft). The thesis reports mean birds "
-              f"lifted to about 80 mm; our centre rises "
-              f"{1e3 * hard.summary['centre_rise_m']:.0f} mm. The lower fingers reach the "
-              f"conveyor's centre line (drum radius + finger = half the drum spacing), so in a "
-              f"quasi-static elastica model they must bend far around a 132 mm wide bird; the "
-              f"thesis computed its forces with Algorithm I's uniform stand-in, whose contact "
-              f"point we found 16-25 mm from the non-uniform finger's (contact report).",
-              f"* Football (Table 5-4, Figures 5-13/5-14): the thesis measured a rise of about "
-              f"18 mm. Ours rises {1e3 * fb.summary['centre_rise_m']:.0f} mm at the centre, "
-              f"{1e3 * fb.summary['belt_clearance_m']:.0f} mm at its lowest point, and then tumbles: "
-              f"the long finger 5 reaches the light ball's side first and kicks it backwards "
-              f"(X at 2 s: {fb.trajectory.records[-1].y[0]:+.2f} m). A pitch-only rigid "
-              f"ellipsoid with no rolling resistance cannot stop tumbling once turned over; the "
-              f"real football did not turn over. This is the largest disagreement we have.",
-              f"* µ = 0 pushes the football back (Figure 5-16): with no finger friction ours ends "
-              f"at X = {fb0.trajectory.records[-1].y[0]:+.2f} m against "
-              f"{fb.trajectory.records[-1].y[0]:+.2f} m with µ = 1.16: pushed back further, as "
-              f"the thesis says.",
-              "* Finger 3 with φx < 60° pushes the football back (Figure 5-17/5-18): in our "
-              "reading finger 3 passes under the football without touching it, so its φx has "
-              "no effect here; not reproduced.",
-              f"* Bird sizes (Table 5-5, X0 = -0.381 m): the small bird loses its support "
-              f"earlier, as the thesis reports (its first N = 0 window ends at "
-              f"{small.summary['hold_windows'][0][1]:.3f} s, the 1.80 kg bird's at "
-              f"{mean.summary['hold_windows'][0][1]:.3f} s); the 2.30 kg bird is not lifted "
-              f"at all.", ""]
-    return "\n".join(lines)
-
-
-if __name__ == "__main__":
-    from design.io.results import write_atomic
-
-    path = TOOLKIT_ROOT / "reports" / "reproduction" / "grasp.md"
-    write_atomic(path, markdown())
-    print(path)

@@ -112,6 +112,11 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
                    "outside its validity: " + "; ".join(check["model_warnings"]))
     elif check["passed"]:
         status, message = "verified", "the independent simulation confirms the design"
+    elif not np.isfinite(claimed):
+        status = "optimiser failed"
+        errors = list(dict.fromkeys(i.get("error") or i.get("ipopt_status", "")
+                                    for i in outcome.iterations))
+        message = "no optimisation step could be computed: " + "; ".join(errors)
     elif not outcome.feasible:
         status = "infeasible"
         message = _diagnosis(space, problem, best, cap, variables)

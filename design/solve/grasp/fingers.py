@@ -138,6 +138,7 @@ class PlanarFinger:
     edge of sliding, reversed when the finger clearly slides the other way."""
 
     name = "planar"
+    from_committed = False
 
     def __init__(self, finger, friction: float, intervals: int, degree: int,
                  reversal_speed: float = REVERSAL_SPEED):
@@ -177,6 +178,7 @@ class SpatialFinger:
     """
 
     name = "spatial"
+    from_committed = True
 
     def __init__(self, finger, friction: float, intervals: int, degree: int):
         self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
@@ -263,9 +265,12 @@ class FingerForces:
             if self.active(i, t):
                 base, R = self.drum.frame(gf.mount, t)
                 # continue from the latest solution, trial or committed: the nearest
-                # in time (trials keep the committed friction)
-                start = self.states[i] if commit else self.trials[i]
-                force, p_w, sol, cont = self.models[i].solve(
+                # in time (trials keep the committed friction); or, for a model whose
+                # friction depends on the solution it starts from, always from the
+                # committed one, so the loads are a function of the state alone
+                model = self.models[i]
+                start = self.states[i] if commit or model.from_committed else self.trials[i]
+                force, p_w, sol, cont = model.solve(
                     body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
                     commit)
             else:

@@ -34,7 +34,8 @@ INTEGRATORS = ("adaptive", "bdf4")
 @dataclass(frozen=True)
 class IntegratorSettings:
     """How to integrate: ``adaptive`` (rtol, atol in m, max_step s, stepper) or
-    ``bdf4`` (step h in s)."""
+    ``bdf4`` (step h in s); ``max_wall_time`` (s, None: no limit) stops a run
+    that takes longer, as not ok, saying where it got to."""
 
     integrator: str = "adaptive"
     #: rtol 1e-4 / atol 1e-6 m: measured by ``design tradeoff
@@ -45,11 +46,13 @@ class IntegratorSettings:
     max_step: float = 5e-3
     stepper: str = "rk45"
     step: float = 5.6e-3
+    max_wall_time: float | None = None
 
     def finer(self, factor: float = 4.0) -> "IntegratorSettings":
         """Settings at ``factor`` times finer resolution (a reference run)."""
         return IntegratorSettings(self.integrator, self.rtol / factor ** 4, self.atol / factor ** 4,
-                                  self.max_step / factor, self.stepper, self.step / factor)
+                                  self.max_step / factor, self.stepper, self.step / factor,
+                                  self.max_wall_time)
 
 
 @dataclass
@@ -74,6 +77,17 @@ class Trajectory:
     wall_time: float = 0.0
     message: str = ""
     ok: bool = True
+    #: stopped by IntegratorSettings.max_wall_time (not ok, but no failure)
+    out_of_time: bool = False
+
+    def over_budget(self, started: float, budget: float | None, t: float, t_end: float) -> bool:
+        """Stop (and say so) once the run has taken longer than ``budget`` s."""
+        if budget is None or time.perf_counter() - started <= budget:
+            return False
+        self.ok, self.out_of_time = False, True
+        self.message = (f"stopped by its wall-time budget of {budget:g} s at t = {t:.4f} s of "
+                        f"{t_end:g} s, after {self.steps} steps")
+        return True
 
 
 class Grasp:
@@ -222,6 +236,7 @@ def _locate(f, dense, t_old: float, t_new: float) -> float:
 
 
 def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, progress):
+    started = time.perf_counter()
     t = 0.0
     mode, slip_sign, y = decide_mode(grasp, t, np.asarray(y0, float))
     traj.records.append(grasp.record(t, y, mode, slip_sign))
@@ -240,6 +255,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 traj.ok, traj.message = False, f"integrator failed at t = {t_old:.4f} s: {msg}"
                 return traj
             traj.steps += 1
+            if traj.over_budget(started, s.max_wall_time, t_old, t_end):
+                return traj
             dense = stepper.dense_output()
             t_new, y_new = stepper.t, stepper.y.copy()
             hits = []
@@ -294,7 +311,10 @@ def _bdf4(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, prog
     n_steps = int(np.ceil(t_end / h - 1e-9))
     rec = grasp.record(t, y, mode, 0.0)
     traj.records.append(rec)
+    started = time.perf_counter()
     for n in range(n_steps):
+        if traj.over_budget(started, s.max_wall_time, t, t_end):
+            return traj
         loads, _ = grasp.fingers.evaluate(t, y)            # frozen over the step
         v, v_dot = grasp.belt(t)
         sign = float(np.sign(dyn.slip(y, v)))               # frozen friction sign

@@ -41,6 +41,8 @@ from design.solve.optimize.variables import DesignSpace, parameters_of
 OBJECTIVE_SCALE = 0.1
 #: no phase shorter than this (s)
 MIN_DURATION = 1e-4
+#: the NLP's bound on the bird's pitch (rad): the optimiser does not design tumbles
+MAX_PITCH = 1.5
 
 
 @dataclass(frozen=True)
@@ -194,9 +196,18 @@ class DesignNLP:
             h = durations[j] / phase.intervals
             nodes = ca.MX.sym(f"y{j}", 6, phase.intervals)
             w.append(ca.vec(nodes))
+            pitch = np.abs(phase.states[:, 2])
+            if pitch.max() > MAX_PITCH:
+                k = int(np.argmax(pitch))
+                at = phase.t0 + k * phase.duration / phase.intervals
+                raise ValueError(
+                    f"the simulated bird turns over inside the optimiser's window (pitch "
+                    f"{phase.states[k, 2]:+.2f} rad at t = {at:.3f} s; the NLP keeps |pitch| "
+                    f"<= {MAX_PITCH} rad): no design can start from it")
             w0.append(phase.states.ravel())
-            lbw.append(np.tile([-np.inf, 0.0, -1.5, -np.inf, -np.inf, -np.inf], phase.intervals))
-            ubw.append(np.tile([np.inf, 0.5, 1.5, np.inf, np.inf, np.inf], phase.intervals))
+            lbw.append(np.tile([-np.inf, 0.0, -MAX_PITCH, -np.inf, -np.inf, -np.inf],
+                               phase.intervals))
+            ubw.append(np.tile([np.inf, 0.5, MAX_PITCH, np.inf, np.inf, np.inf], phase.intervals))
             mode_f = self._mode_function(phase.mode, phase.sign)
             first = nodes[:, 0]
             if previous_end is None:
