@@ -189,13 +189,16 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
 
 def unfinished(rows_of, runs: dict[str, GraspRun], names: list[str], case: str, quantity: str,
                thesis: str) -> list[Row]:
-    """``rows_of()`` if every named run finished, else one row saying which did not."""
+    """``rows_of()`` if every named run finished, else one row saying which did
+    not, with where the others went."""
     late = [f"{n}: {runs[n].summary['message']}" for n in names
             if runs[n].trajectory.out_of_time]
     if not late:
         return rows_of()
+    done = [f"{n}: {_motion(runs[n])}" for n in names if not runs[n].trajectory.out_of_time]
     return [claim(case, quantity, thesis, "not finished", False,
-                  f"Not computed within {RUN_BUDGET:g} s per run: " + "; ".join(late) + ".")]
+                  f"Not computed within {RUN_BUDGET:g} s per run: " + "; ".join(late) + "."
+                  + (" Finished: " + "; ".join(done) + "." if done else ""))]
 
 
 def _motion(run: GraspRun) -> str:
