@@ -36,6 +36,7 @@ from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, le
                                     level_conic)
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import BeamTranscription, transcription
+from design.solve.newton import NewtonCache
 
 MODES = ("interior", "tip")
 #: ellipse parameterisations: (level, gradient) functions of (x, y, q[ELLIPSE])
@@ -109,20 +110,12 @@ class ContactTranscription:
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
             [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
-        self._rootfinders: dict = {}
+        self._newton = NewtonCache(f"contact_{self.mode}_newton", self.residual, "qr")
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40,
                    error_on_fail: bool = False) -> ca.Function:
-        """Newton with line search on R(z, q) = 0: (z0, q) -> z (cached).
-        ``error_on_fail``: raise instead of returning the last iterate (inside
-        an NLP, where Ipopt then shortens its step)."""
-        key = (tolerance, max_iter, error_on_fail)
-        if key not in self._rootfinders:
-            self._rootfinders[key] = ca.rootfinder(
-                f"contact_{self.mode}_newton", "newton", self.residual,
-                {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
-                 "line_search": True, "linear_solver": "qr", "show_eval_warnings": False})
-        return self._rootfinders[key]
+        """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton)."""
+        return self._newton.get(tolerance, max_iter, error_on_fail)
 
     def parameters(self, length: float, ei_ref: float, ellipse: Ellipse, tau_mu: float,
                    widths: np.ndarray, stiffness: Stiffness) -> np.ndarray:

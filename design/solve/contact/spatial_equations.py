@@ -28,6 +28,7 @@ import casadi as ca
 import numpy as np
 
 from design.solve.beam.rod import RodStiffness, rod_transcription
+from design.solve.newton import NewtonCache
 
 MODES = ("interior", "tip")
 #: index of the quadric (c, Q) in q
@@ -99,19 +100,13 @@ class SpatialContactTranscription:
         self.sensitivity = ca.Function(
             f"spatial_{mode}_sens", [z, q],
             [ca.jacobian(R, z), ca.jacobian(R, q[QUADRIC]), ca.jacobian(ca.vertcat(r, L), z)])
-        self._rootfinders: dict = {}
+        # sparse LU: the collocation Jacobian is banded but for the load's columns
+        self._newton = NewtonCache(f"spatial_{mode}_newton", self.residual, "csparse")
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 30,
                    error_on_fail: bool = False) -> ca.Function:
-        """Newton with line search on R(z, q) = 0: (z0, q) -> z (cached); sparse LU
-        (the collocation Jacobian is banded but for the load's columns)."""
-        key = (tolerance, max_iter, error_on_fail)
-        if key not in self._rootfinders:
-            self._rootfinders[key] = ca.rootfinder(
-                f"spatial_{self.mode}_newton", "newton", self.residual,
-                {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
-                 "line_search": True, "linear_solver": "csparse", "show_eval_warnings": False})
-        return self._rootfinders[key]
+        """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton)."""
+        return self._newton.get(tolerance, max_iter, error_on_fail)
 
     def parameters(self, length: float, ei_ref: float, c: np.ndarray, Q: np.ndarray,
                    friction: np.ndarray, widths: np.ndarray, stiffness: RodStiffness
