@@ -280,15 +280,18 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 restart = True
                 continue
             before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
-            traj.records.append(grasp.record(t_new, y_new, mode, slip_sign))
+            record = grasp.record(t_new, y_new, mode, slip_sign)
             after = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
             t, y = t_new, y_new
             if any(a is not None and b is not None and a != b for a, b in zip(before, after)):
                 # a finger's friction turned: a new smooth piece, and the belt
-                # contact must be decided again under the new forces
+                # contact must be decided again under the new forces before the
+                # instant is recorded (the old mode could need N < 0)
                 restart = True
                 if mode != "air":
                     mode, slip_sign, y = decide_mode(grasp, t, y)
+                    record = grasp.record(t, y, mode, slip_sign)
+            traj.records.append(record)
             if progress and t - last_report >= 0.1:
                 progress(f"grasp: t = {t:.2f} s of {t_end:g} s, mode {mode}, "
                          f"{traj.steps} steps")
