@@ -1,6 +1,7 @@
 """Design problem files: what is accepted, and bad input rejected with one
 clear message per problem, exit status 2 and nothing written."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -84,3 +85,23 @@ def test_solve_and_simulate_refuse_each_others_files(tmp_path, capsys):
     assert main(["simulate", str(ROOT / "problems" / "hold_time.yaml"), "--out", str(out)]) == 2
     assert "use 'design solve'" in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_rule_5_3_counts_the_graspers_finger_sets():
+    """Eq. 5.3: v/ω = n Δx / (2π). The thesis's 0.457 m/s belt at 20 rpm with
+    its three finger sets spaces birds 0.457 m apart (one per 1 s cycle); the
+    rule's n defaults to the grasper's sets, so that spacing holds, and the
+    same spacing with n = 1 does not."""
+    from design.reproduce.grasp import thesis_setup
+    from design.solve.optimize.transcription import Rules, rule_margins
+    from design.solve.optimize.variables import parameters_of, timed_conveyor
+
+    setup = thesis_setup(0.0, 0.6)
+    setup = replace(setup, conveyor=timed_conveyor(setup.conveyor, None))
+    values = parameters_of(setup)
+
+    def worst(rules):
+        return min(m for m, name in rule_margins(values, setup, rules) if "5.3" in name)
+
+    assert worst(Rules(bird_spacing=0.457)) >= 0
+    assert worst(Rules(bird_spacing=0.457, finger_sets=1)) < -0.1

@@ -11,7 +11,7 @@ bounds, the bruise cap, the design rules and the solver settings.
       groups.lower.stiffness_scale: [0.5, 2.0]
       fingers.4.angle: [-165 deg, -135 deg]
     cap: baseline              # N | baseline | {relative_to_baseline: 0.75} | a list: Pareto study
-    rules: {sigma_lambda: 0.01, bird_spacing: 0.3, finger_sets: 1}
+    rules: {sigma_lambda: 0.01, bird_spacing: 0.3}   # finger_sets: the grasper's sets
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}
 
@@ -211,8 +211,9 @@ def _rules(reader: Reader, value: object) -> Rules | None:
     sigma = reader.quantity(spec, "sigma_lambda", "rules", "length", lo=0.0, default=0.0)
     spacing = reader.quantity(spec, "bird_spacing", "rules", "length", lo=0.0, lo_open=True,
                               default=None)
-    sets = reader.integer(spec, "finger_sets", "rules", lo=1, hi=12, default=1)
-    if None in (sigma, sets):
+    sets = reader.integer(spec, "finger_sets", "rules", lo=1, hi=12, default=None) \
+        if "finger_sets" in spec else None
+    if sigma is None or ("finger_sets" in spec and sets is None):
         return None
     return Rules(sigma, spacing, sets)
 

@@ -73,11 +73,12 @@ class NLPSettings:
 class Rules:
     """Design rules of §5.1 as constraints: drum spacing ≥ λ + σ_λ and ≥
     every finger's length (5.7); ``bird_spacing`` Δx (m) with ``finger_sets``
-    n fixes the speed ratio v/ω = n Δx / (2π) (5.3-5.4)."""
+    n (None: the grasper's own number of sets) fixes the speed ratio
+    v/ω = n Δx / (2π) (5.3-5.4)."""
 
     sigma_lambda: float = 0.0
     bird_spacing: float | None = None
-    finger_sets: int = 1
+    finger_sets: int | None = None
 
 
 @dataclass
@@ -369,7 +370,8 @@ def rule_margins(values: dict, setup, rules: Rules) -> list:
         out.append((values["spacing"] - values[f"fingers.{name}.length"],
                     f"rule 5.7: d >= l ({name})"))
     if rules.bird_spacing is not None:
-        ratio = rules.finger_sets * rules.bird_spacing / (2 * np.pi)
+        sets = rules.finger_sets or len({gf.phase for gf in setup.grasper.fingers})
+        ratio = sets * rules.bird_spacing / (2 * np.pi)
         gap = setup.conveyor.speed / values["drum_speed"] - ratio
         out += [(gap + 1e-6, "rule 5.3: v/omega"), (1e-6 - gap, "rule 5.3: v/omega")]
     return out
