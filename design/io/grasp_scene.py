@@ -256,15 +256,10 @@ def _remounted(reader: Reader, grasper: Grasper, value: object) -> Grasper:
             continue
         fields = reader.mapping(item, path, optional=MOUNT_FIELDS)
         if fields is not None:
-            changes[str(name)] = {k: reader.quantity(fields, k, path, "angle", lo=-2 * np.pi,
-                                                     hi=2 * np.pi) for k in fields}
-    fingers = []
-    for gf in grasper.fingers:
-        change = {k: v for k, v in changes.get(gf.design_name, {}).items() if v is not None}
-        if "angle" in change:
-            change["angle"] += gf.phase
-        fingers.append(replace(gf, mount=replace(gf.mount, **change)) if change else gf)
-    return replace(grasper, fingers=tuple(fingers))
+            values = {k: reader.quantity(fields, k, path, "angle", lo=-2 * np.pi, hi=2 * np.pi)
+                      for k in fields}
+            changes[str(name)] = {k: v for k, v in values.items() if v is not None}
+    return grasper.remounted(changes)
 
 
 def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspScene | None:
@@ -292,10 +287,7 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
     if grasper is not None and "mounts" in data:
         grasper = _remounted(reader, grasper, data["mounts"])
     if grasper is not None and models:
-        grasper = replace(grasper, fingers=tuple(
-            replace(gf, finger=replace(models[gf.group], length=gf.finger.length))
-            if gf.group in models else gf
-            for gf in grasper.fingers))
+        grasper = grasper.with_models(models)
         unknown = set(models) - {gf.group for gf in grasper.fingers}
         for group in sorted(unknown):
             reader.add(join("finger_models", group), f"no finger of the grasper is in group "

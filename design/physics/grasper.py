@@ -48,6 +48,24 @@ class Grasper:
     def drum(self, speed: float) -> Drum:
         return Drum(self.spacing, speed, self.x, self.tilt)
 
+    def with_models(self, models: dict[str, Finger]) -> "Grasper":
+        """Every finger of a group in ``models`` (by group) made of that finger
+        model, each keeping its own length."""
+        return replace(self, fingers=tuple(
+            replace(gf, finger=replace(models[gf.group], length=gf.finger.length))
+            if gf.group in models else gf for gf in self.fingers))
+
+    def remounted(self, changes: dict[str, dict[str, float]]) -> "Grasper":
+        """Every set's copy of a designed finger (by design name) with its mount
+        changed: ``{"3": {"phi_x": 1.05}}`` (rad; an angle is set a's)."""
+        fingers = []
+        for gf in self.fingers:
+            change = dict(changes.get(gf.design_name, {}))
+            if "angle" in change:
+                change["angle"] += gf.phase
+            fingers.append(replace(gf, mount=replace(gf.mount, **change)) if change else gf)
+        return replace(self, fingers=tuple(fingers))
+
     def with_finger(self, index: int, finger: GraspFinger) -> "Grasper":
         fingers = list(self.fingers)
         fingers[index] = finger

@@ -36,18 +36,13 @@ def load_model(kind_reader, *path):
 def with_lower(grasper, finger_file: str, groups: tuple[str, ...] = ("lower",)):
     """The grasper with every finger of ``groups`` in another finger model."""
     model = load_model(read_finger, "fingers", finger_file)
-    return replace(grasper, fingers=tuple(
-        replace(f, finger=replace(model, length=f.finger.length))
-        if f.group in groups else f for f in grasper.fingers))
+    return grasper.with_models({g: model for g in groups})
 
 
 def with_phi_x(setup: GraspSetup, family: str, degrees: float) -> GraspSetup:
     """The setup with every set's copy of finger ``family`` at φx = ``degrees``
     (Table 5-1's sense, as the grasper file uses it)."""
-    g = setup.grasper
-    return replace(setup, grasper=replace(g, fingers=tuple(
-        replace(f, mount=replace(f.mount, phi_x=np.radians(degrees)))
-        if f.design_name == family else f for f in g.fingers)))
+    return replace(setup, grasper=setup.grasper.remounted({family: {"phi_x": np.radians(degrees)}}))
 
 
 def advanced(grasper, t_skip: float, omega: float = OMEGA):
