@@ -156,3 +156,41 @@ def test_written_finger_keeps_every_rigidity(name):
     for a, b in [(finger.stiffness, again.stiffness), (finger.stiffness_out, again.stiffness_out),
                  (finger.torsion_rigidity, again.torsion_rigidity)]:
         np.testing.assert_allclose(b.ei(s), a.ei(s), rtol=1e-12)
+
+
+PNG = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x01"
+
+
+@pytest.mark.parametrize("command", ["simulate", "solve", "tradeoff"])
+def test_a_binary_file_is_named_and_nothing_is_written(tmp_path, capsys, command):
+    """A PNG renamed .yaml: exit 2, a message naming the file, no output
+    folder (issue 12, item 7), not a UnicodeDecodeError traceback."""
+    image = tmp_path / "picture.yaml"
+    image.write_bytes(PNG)
+    out = tmp_path / "out"
+    assert main([command, str(image), "--out", str(out), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert f"error: {image}: not a text file (byte 0x89 at offset 0 is not UTF-8)" in err
+    assert "1 problem found; nothing was written." in err
+    assert not out.exists()
+
+
+def test_check_goes_on_past_a_binary_file(tmp_path, capsys):
+    """`design check a.yaml x.png b.yaml` checks all three and exits 2."""
+    image = tmp_path / "x.png"
+    image.write_bytes(PNG)
+    a, b = ROOT / "problems" / "beam_table_2_1.yaml", ROOT / "problems" / "beam_table_2_3.yaml"
+    assert main(["check", str(a), str(image), str(b)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out.splitlines() == [f"{a}: OK", f"{b}: OK"]
+    assert f"error: {image}: not a text file" in captured.err
+
+
+def test_a_binary_model_file_is_named(tmp_path, capsys):
+    """A scene whose finger file is binary: the problem names the finger file."""
+    finger = tmp_path / "finger.yaml"
+    finger.write_bytes(b"kind: finger\nlength: 0.2\n\xff\xfe")
+    path = write(tmp_path, with_changes(finger=str(finger)))
+    assert main(["check", str(path)]) == 2
+    assert (f"error: {finger}: not a text file (byte 0xff at offset 25 is not UTF-8)"
+            in capsys.readouterr().err)

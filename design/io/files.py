@@ -19,6 +19,11 @@ def load_yaml(path: Path, reader: Reader, field: str = "") -> object | None:
     except OSError as exc:
         reader.add(field, f"cannot read file '{path}': {exc.strerror or exc}")
         return None
+    except UnicodeDecodeError as exc:
+        reader.add(field, f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                          f"{exc.start} is not UTF-8); expected a YAML scene, problem or "
+                          f"model file")
+        return None
     try:
         return yaml.safe_load(text)
     except yaml.YAMLError as exc:
