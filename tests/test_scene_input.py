@@ -194,3 +194,37 @@ def test_a_binary_model_file_is_named(tmp_path, capsys):
     assert main(["check", str(path)]) == 2
     assert (f"error: {finger}: not a text file (byte 0xff at offset 25 is not UTF-8)"
             in capsys.readouterr().err)
+
+
+@pytest.mark.parametrize("problem, key, typo", [
+    ("beam_table_2_3.yaml", "load.alpha", ("alpha:", "alph:")),
+    ("grasp_mean_bird_hard.yaml", "drum_speed", ("drum_speed:", "drum_sped:")),
+    ("hold_time.yaml", "scene", ("scene:", "scen:")),
+])
+def test_a_misspelt_key_is_two_problems_each_said_once(tmp_path, capsys, problem, key, typo):
+    """The unknown key and the missing one, each once, counted as 2 (issue 12,
+    item 10; a design problem without `scene` used to raise KeyError)."""
+    path = tmp_path / problem
+    path.write_text((ROOT / "problems" / problem).read_text().replace(*typo, 1))
+    out = tmp_path / "out"
+    command = "solve" if problem.startswith("hold_time") else "simulate"
+    assert main([command, str(path), "--out", str(out)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert err.count(f"error: {path}: {key}: required but missing") == 1, err
+    assert [line for line in err if line.startswith("error:")][0].startswith(
+        f"error: {path}: {key.replace(typo[0][:-1], typo[1][:-1])}: unknown key")
+    assert err[-1] == "2 problems found; nothing was written."
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("cwd", ["scene folder's parent", "toolkit root"])
+def test_missing_model_file_names_each_folder_once(tmp_path, capsys, monkeypatch, cwd):
+    from design.io.files import TOOLKIT_ROOT
+    folder = tmp_path / "problems"
+    folder.mkdir()
+    path = write(folder, with_changes(finger="models/fingers/none.yaml"))
+    monkeypatch.chdir(tmp_path if cwd == "scene folder's parent" else TOOLKIT_ROOT)
+    assert main(["check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert (f"finger file 'models/fingers/none.yaml' not found (looked in {folder} and the "
+            f"folders above it, {TOOLKIT_ROOT})\n") in err

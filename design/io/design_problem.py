@@ -82,8 +82,9 @@ def variable_names(scene: GraspScene) -> list[str]:
 
 
 def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> DesignProblem | None:
-    scene = _scene(reader, data["scene"], base_dir)
-    variables = _variables(reader, data["variables"], scene)
+    # a missing scene or variables key is already a problem (the top-level key check)
+    scene = _scene(reader, data["scene"], base_dir) if "scene" in data else None
+    variables = _variables(reader, data["variables"], scene) if "variables" in data else None
     caps = _caps(reader, data.get("cap", "baseline"))
     rules = _rules(reader, data.get("rules", {}))
     settings = _settings(reader, data.get("solver", {}))
@@ -116,7 +117,7 @@ def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
     except ProblemFileError as exc:
         for p in exc.problems:
             if isinstance(value, str):
-                reader.problems.append(p)
+                reader.record(p)
             else:
                 reader.add(join("scene", p.field), p.message)
         return None

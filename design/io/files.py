@@ -51,6 +51,13 @@ def resolve(reference: str, base_dir: Path) -> Path | None:
     return None
 
 
+def searched(base_dir: Path) -> str:
+    """The folders :func:`resolve` looks in, each named once."""
+    above = [base_dir, *base_dir.parents]
+    others = [str(f) for f in dict.fromkeys([Path.cwd(), TOOLKIT_ROOT]) if f not in above]
+    return ", ".join([f"{base_dir} and the folders above it", *others])
+
+
 def read_model(reader: Reader, value: object, field: str, base_dir: Path, kind: str, parse):
     """A model given inline (a mapping) or as a path to a model file.
 
@@ -61,8 +68,8 @@ def read_model(reader: Reader, value: object, field: str, base_dir: Path, kind: 
     if isinstance(value, str):
         path = resolve(value, base_dir)
         if path is None:
-            reader.add(field, f"{kind} file '{value}' not found (looked in {base_dir}, its "
-                              f"parent folders, {Path.cwd()} and {TOOLKIT_ROOT})")
+            reader.add(field, f"{kind} file '{value}' not found (looked in "
+                              f"{searched(base_dir)})")
             return None
         sub = Reader(str(path))
         data = load_yaml(path, sub)
@@ -72,6 +79,7 @@ def read_model(reader: Reader, value: object, field: str, base_dir: Path, kind: 
                 sub.add("kind", f"'{data['kind']}' where a {kind} is expected")
             else:
                 model = parse(sub, data, "", path.resolve().parent, path.stem)
-        reader.problems.extend(sub.problems)
+        for problem in sub.problems:
+            reader.record(problem)
         return model
     return parse(reader, value, field, base_dir, "")

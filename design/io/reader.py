@@ -47,7 +47,13 @@ class Reader:
         return not self.problems
 
     def add(self, field: str, message: str) -> None:
-        self.problems.append(Problem(self.file, field, message))
+        self.record(Problem(self.file, field, message))
+
+    def record(self, problem: Problem) -> None:
+        """Keep ``problem`` once: two checks can find the same one (the
+        mapping's required keys and the field's own reader)."""
+        if problem not in self.problems:
+            self.problems.append(problem)
 
     def raise_if_any(self) -> None:
         if self.problems:
