@@ -17,6 +17,7 @@ from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
+from design.io.results import check_output_folder
 from design.io.scene import check_file, load_scene
 from design.report import write_run
 from design.run import Progress, RunOutput
@@ -46,7 +47,11 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
     ------
     design.errors.ProblemFileError
         If the scene has problems (nothing is written then).
+    design.io.results.OutputFolderError
+        If ``out`` cannot be written to (checked before the run).
     """
+    if out is not None:
+        check_output_folder(Path(out))
     output = run_scene(source, progress)
     if out is not None:
         write_run(Path(out), output)

@@ -28,6 +28,20 @@ def _report_problems(exc: ProblemFileError) -> int:
     return EXIT_BAD_INPUT
 
 
+def output_folder(given: str | None, default: Path) -> Path | None:
+    """The run's output folder (``--out``, else ``default``), checked before
+    the run starts; None, with the reason printed, when it cannot be written."""
+    from design.io.results import OutputFolderError, check_output_folder
+
+    out = Path(given) if given else default
+    try:
+        check_output_folder(out)
+    except OutputFolderError as exc:
+        print(f"error: {exc}. Nothing was written.", file=sys.stderr)
+        return None
+    return out
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     from design.api import RUNNERS
     from design.io.design_problem import DesignProblem
@@ -44,9 +58,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(f"error: {args.scene}: kind: 'design {args.command}' needs {wanted}; use "
               f"'{other}' for this file. Nothing was written.", file=sys.stderr)
         return EXIT_BAD_INPUT
+    out = output_folder(args.out, Path("reports") / (scene.name or Path(args.scene).stem))
+    if out is None:
+        return EXIT_BAD_INPUT
     output = RUNNERS[type(scene)](scene, None if args.quiet else _progress)
-    name = output.result.get("name") or Path(args.scene).stem
-    out = Path(args.out) if args.out else Path("reports") / name
     written = write_run(out, output)
     for path in written:
         print(path)

@@ -2,6 +2,7 @@
 
 import csv
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -69,3 +70,75 @@ def test_the_documented_api_is_callable_and_the_version_is_shown(capsys):
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
     assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"design {design.__version__}"
+
+
+def _must_not_run(*args, **kwargs):
+    raise AssertionError("the run started although its output folder cannot be written")
+
+
+@pytest.fixture
+def nothing_runs(monkeypatch):
+    """Every command's work replaced by a failure: the folder check must come first."""
+    from design.api import RUNNERS
+    from design.reproduce import command as reproduce
+    from design.tradeoff import command as tradeoff
+
+    for kind in RUNNERS:
+        monkeypatch.setitem(RUNNERS, kind, _must_not_run)
+    for kind in tradeoff.STUDIES:
+        monkeypatch.setitem(tradeoff.STUDIES, kind, _must_not_run)
+    monkeypatch.setattr(reproduce, "compute_sections", _must_not_run)
+
+
+COMMANDS = {"simulate": ["simulate", str(ROOT / "problems" / "beam_table_2_1.yaml")],
+            "solve": ["solve", str(ROOT / "problems" / "hold_time.yaml")],
+            "tradeoff": ["tradeoff", str(ROOT / "problems" / "beam_table_2_1.yaml")],
+            "reproduce": ["reproduce"]}
+
+
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_an_output_folder_under_a_file_is_refused_before_the_run(tmp_path, capsys, nothing_runs,
+                                                                  command):
+    """Issue 12, item 8: exit 2 naming the folder, before anything runs or is written."""
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    out = blocker / "out"
+    assert main([*COMMANDS[command], "--out", str(out), "--quiet"]) == 2
+    assert capsys.readouterr().err == (f"error: output folder '{out}' cannot be created: "
+                                       f"'{blocker}' is a file. Nothing was written.\n")
+    assert [p.name for p in tmp_path.iterdir()] == ["a_file"]
+    assert blocker.read_text() == "not a folder"
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes to read-only folders")
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_a_read_only_output_folder_is_refused_before_the_run(tmp_path, capsys, nothing_runs,
+                                                             command):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        assert main([*COMMANDS[command], "--out", str(locked / "out"), "--quiet"]) == 2
+        err = capsys.readouterr().err
+        assert f"output folder '{locked / 'out'}' cannot be written to: Permission denied" in err
+        assert not any(locked.iterdir())
+    finally:
+        locked.chmod(0o755)
+
+
+def test_the_api_checks_its_output_folder_before_the_run(tmp_path, nothing_runs):
+    from design.io.results import OutputFolderError
+
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    with pytest.raises(OutputFolderError, match="is a file"):
+        design.simulate(ROOT / "problems" / "beam_table_2_1.yaml", out=blocker / "out")
+
+
+@pytest.mark.skipif(not Path("/proc/self").is_dir(), reason="needs Linux's /proc")
+def test_an_output_folder_where_no_file_can_be_made_is_refused(capsys, nothing_runs):
+    """/proc takes no new files, not even from root."""
+    assert main([*COMMANDS["simulate"], "--out", "/proc/design-out", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: output folder '/proc/design-out' cannot be written to: ")
+    assert err.endswith("(creating a file in '/proc'). Nothing was written.\n")

@@ -31,6 +31,36 @@ def jsonable(value: object) -> object:
     return value
 
 
+class OutputFolderError(ValueError):
+    """A run's output folder cannot be created or written to."""
+
+
+def check_output_folder(out_dir: Path) -> None:
+    """Check, before a run starts, that its files can be written to ``out_dir``.
+
+    The folder, or the nearest folder above it that exists, must be a folder
+    in which a file can be created. The probe is an unnamed temporary file:
+    nothing is left behind.
+
+    Raises
+    ------
+    OutputFolderError
+        Naming the folder and the reason.
+    """
+    folder = Path(out_dir).absolute()
+    while not folder.exists():
+        folder = folder.parent
+    if not folder.is_dir():
+        raise OutputFolderError(f"output folder '{out_dir}' cannot be created: '{folder}' "
+                                f"is a file")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as exc:
+        raise OutputFolderError(f"output folder '{out_dir}' cannot be written to: "
+                                f"{exc.strerror or exc} (creating a file in '{folder}')") from None
+
+
 def write_atomic_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file and a rename, so
     that an interrupted run leaves the old file or none, never half a file."""

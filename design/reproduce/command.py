@@ -3,7 +3,8 @@ reproduction report (reproduction.json, reproduction.csv, report.html and
 figures/*.png), every row a thesis number or claim against ours.
 
 Exit status: 0 every case computed; 1 a case could not be computed (the
-report is still written, saying which).
+report is still written, saying which); 2 the output folder cannot be
+written (checked before the first case runs).
 """
 
 from __future__ import annotations
@@ -101,11 +102,13 @@ def build_page(sections: list[Section], failures: list[str], quick: bool,
 
 def cmd_reproduce(args: argparse.Namespace) -> int:
     """Run the reference cases, write the report; print the paths written."""
-    from design.cli import EXIT_FAILED, EXIT_OK, _progress
+    from design.cli import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, _progress, output_folder
 
     t0 = time.perf_counter()
     progress = None if args.quiet else _progress
-    out = Path(args.out) if args.out else Path("reports") / "reproduction"
+    out = output_folder(args.out, Path("reports") / "reproduction")
+    if out is None:
+        return EXIT_BAD_INPUT
     sections, failures = compute_sections(args.quick, progress)
     rows = [r for s in sections for r in s.rows]
     agree, total = tally(rows)

@@ -17,7 +17,7 @@ import time
 from pathlib import Path
 
 from design import __version__
-from design.cli import EXIT_BAD_INPUT, EXIT_OK, _progress, _report_problems
+from design.cli import EXIT_BAD_INPUT, EXIT_OK, _progress, _report_problems, output_folder
 from design.errors import ProblemFileError
 from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
@@ -44,12 +44,15 @@ def cmd_tradeoff(args: argparse.Namespace) -> int:
         scene = load_scene(args.scene)
     except ProblemFileError as exc:
         return _report_problems(exc)
+    name = scene.name or Path(args.scene).stem
+    out = output_folder(args.out, Path("reports") / f"{name}_tradeoff")
+    if out is None:
+        return EXIT_BAD_INPUT
     progress = None if args.quiet else _progress
     start, t0 = os.getloadavg(), time.perf_counter()
     study = STUDIES[type(scene)](scene, args.quick, progress)
     mark_front(study.rows)
     chosen = choose(study.rows, tolerance)
-    name = scene.name or Path(args.scene).stem
     meta = {"name": name, "scene": str(args.scene), "toolkit_version": __version__,
             "quick": bool(args.quick), "wall_time_s": time.perf_counter() - t0,
             "cores": os.cpu_count(),
@@ -58,7 +61,6 @@ def cmd_tradeoff(args: argparse.Namespace) -> int:
     data = report.result(study, chosen, tolerance, meta)
     files = {"tradeoff.json": json_text(data), "tradeoff.csv": report.csv_table(study)}
     page = report.page(study, data, chosen, tolerance)
-    out = Path(args.out) if args.out else Path("reports") / f"{name}_tradeoff"
     written = write_texts(out, files) + write_report(out, page)
     print(report.text_table(report.table_rows(study)))
     print()
