@@ -142,3 +142,37 @@ def test_an_output_folder_where_no_file_can_be_made_is_refused(capsys, nothing_r
     err = capsys.readouterr().err
     assert err.startswith("error: output folder '/proc/design-out' cannot be written to: ")
     assert err.endswith("(creating a file in '/proc'). Nothing was written.\n")
+
+
+def test_reusing_an_output_folder_leaves_only_the_new_runs_files(tmp_path, capsys):
+    """Issue 12, item 9: a contact scene run into a beam scene's folder
+    removes the beam's shapes.csv and figure; a file the toolkit did not
+    write stays."""
+    out = tmp_path / "out"
+    assert main(["simulate", str(ROOT / "problems" / "beam_table_2_1.yaml"), "--out", str(out),
+                 "--quiet"]) == 0
+    assert (out / "shapes.csv").is_file() and (out / "figures" / "deflection.png").is_file()
+    (out / "notes.txt").write_text("mine")
+    capsys.readouterr()
+    assert main(["simulate", str(ROOT / "problems" / "contact_case1.yaml"), "--out", str(out),
+                 "--quiet"]) == 0
+    written = capsys.readouterr().out.split()
+    assert sorted(str(p) for p in out.rglob("*") if p.is_file()) == sorted(
+        [*written, str(out / "notes.txt"), str(out / ".design-outputs")])
+    assert json.loads((out / "result.json").read_text())["kind"] == "contact"
+    assert (out / ".design-outputs").read_text().split() == [
+        str(Path(p).relative_to(out).as_posix()) for p in written]
+
+
+def test_a_manifest_never_removes_files_outside_its_folder(tmp_path):
+    from design.io.results import MANIFEST, record_outputs
+
+    out, outside = tmp_path / "out", tmp_path / "outside.txt"
+    out.mkdir()
+    outside.write_text("keep")
+    (out / "old.csv").write_text("")
+    (out / MANIFEST).write_text(f"old.csv\n../outside.txt\n{outside}\n{MANIFEST}\n")
+    (out / "new.csv").write_text("")
+    assert record_outputs(out, [out / "new.csv"]) == [out / "old.csv"]
+    assert outside.read_text() == "keep" and not (out / "old.csv").exists()
+    assert (out / MANIFEST).read_text() == "new.csv\n"

@@ -111,14 +111,47 @@ def write_texts(out_dir: Path, files: dict[str, str]) -> list[Path]:
     return [out_dir / name for name in files]
 
 
-def write_outputs(out_dir: Path, result: dict, tables: dict[str, list[dict]],
-                  texts: dict[str, str] | None = None) -> list[Path]:
-    """Write ``result.json``, each CSV table and further text files; returns
-    the paths written.
-
-    Everything is rendered in memory first, so an error leaves no partial file.
-    """
+def output_files(result: dict, tables: dict[str, list[dict]],
+                 texts: dict[str, str] | None = None) -> dict[str, str]:
+    """A run's files rendered in memory (name -> text): ``result.json``, each
+    CSV table and further text files, so that an error leaves no partial file."""
     files = {"result.json": json_text(result)}
     files.update({name: csv_text(rows) for name, rows in tables.items()})
     files.update(texts or {})
-    return write_texts(out_dir, files)
+    return files
+
+
+#: the list of files the last run wrote to its output folder, one relative path a line
+MANIFEST = ".design-outputs"
+
+
+def record_outputs(out_dir: Path, written: list[Path]) -> list[Path]:
+    """Record the files a run wrote in ``out_dir`` and delete those that the
+    previous run there wrote and this one did not (another kind of scene's
+    ``timeseries.csv`` or figures), so that the folder holds one run's results.
+
+    Files the toolkit did not write are never touched. Returns the paths deleted.
+    """
+    manifest = out_dir / MANIFEST
+    names = [p.relative_to(out_dir).as_posix() for p in written]
+    stale = [out_dir / name for name in _recorded(manifest) if name not in names]
+    for path in stale:
+        if path.is_file():
+            path.unlink()
+        folder = path.parent
+        if folder != out_dir and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+    write_atomic(manifest, "".join(f"{name}\n" for name in names))
+    return stale
+
+
+def _recorded(manifest: Path) -> list[str]:
+    """The relative paths in a manifest; none from an unreadable one, and
+    none that could point outside its folder."""
+    try:
+        lines = manifest.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError):
+        return []
+    return [line for line in lines
+            if line and not Path(line).is_absolute() and ".." not in Path(line).parts
+            and line != MANIFEST]

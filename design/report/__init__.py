@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from design.io.results import write_outputs
+from design.io.results import output_files
 from design.report.page import Page, write_report
 from design.run import RunOutput
 
@@ -28,7 +28,7 @@ def build_report(output: RunOutput) -> Page:
 
 def write_run(out_dir: Path, output: RunOutput) -> list[Path]:
     """Write a run's result.json, tables and files, then its report and figures;
-    every file atomically, the report last. Returns the paths written."""
+    every file atomically, the report last; then remove the files an earlier
+    run in ``out_dir`` wrote and this one did not. Returns the paths written."""
     page = build_report(output)
-    written = write_outputs(out_dir, output.result, output.tables, output.files)
-    return written + write_report(out_dir, page)
+    return write_report(out_dir, page, output_files(output.result, output.tables, output.files))

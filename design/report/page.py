@@ -20,7 +20,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
 
-from design.io.results import write_atomic, write_atomic_bytes  # noqa: E402
+from design.io.results import (  # noqa: E402
+    record_outputs, write_atomic, write_atomic_bytes, write_texts)
 
 STYLE = """
 body{font-family:system-ui,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;margin:2em auto;
@@ -124,14 +125,18 @@ def _align(rows: list[dict], column) -> str:
     return "" if numeric else "text"
 
 
-def write_report(out_dir: Path, page: Page, name: str = "report.html") -> list[Path]:
-    """Write the figures (``figures/*.png``) and then the page, each atomically;
-    returns the paths written."""
-    written = []
+def write_report(out_dir: Path, page: Page, files: dict[str, str] | None = None,
+                 name: str = "report.html") -> list[Path]:
+    """Write a run's output folder: its rendered ``files`` (name -> text), the
+    figures (``figures/*.png``) and then the page, each atomically; then
+    remove what an earlier run there wrote and this one did not
+    (:func:`~design.io.results.record_outputs`). Returns the paths written."""
+    written = write_texts(out_dir, files or {})
     for fig in page.figures:
         path = out_dir / "figures" / fig.name
         write_atomic_bytes(path, fig.png)
         written.append(path)
     write_atomic(out_dir / name, page.render())
     written.append(out_dir / name)
+    record_outputs(out_dir, written)
     return written

@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from design import __version__
-from design.io.results import csv_text, json_text, write_texts
+from design.io.results import csv_text, json_text
 from design.report.page import Page, write_report
 from design.reproduce import beam_rows, contact_rows, grasp_rows
 from design.reproduce.rows import COLUMNS, Section, tally
@@ -121,7 +121,7 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
              "reproduction.csv": csv_text([r.as_dict() for r in rows])}
     if progress:
         progress(f"writing {out}")
-    for path in write_texts(out, files) + write_report(out, page):
+    for path in write_report(out, page, files):
         print(path)
     print(f"{agree} of {total} rows agree with the thesis within their stated tolerance"
           + (f"; could not compute: {'; '.join(failures)}" if failures else ""))

@@ -23,7 +23,7 @@ from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
-from design.io.results import json_text, write_texts
+from design.io.results import json_text
 from design.io.scene import load_scene
 from design.report.page import write_report
 from design.tradeoff import beam, contact, grasp, optimiser, report
@@ -61,7 +61,7 @@ def cmd_tradeoff(args: argparse.Namespace) -> int:
     data = report.result(study, chosen, tolerance, meta)
     files = {"tradeoff.json": json_text(data), "tradeoff.csv": report.csv_table(study)}
     page = report.page(study, data, chosen, tolerance)
-    written = write_texts(out, files) + write_report(out, page)
+    written = write_report(out, page, files)
     print(report.text_table(report.table_rows(study)))
     print()
     for line in data["verdicts"]:
