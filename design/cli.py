@@ -97,6 +97,19 @@ def cmd_check(args: argparse.Namespace) -> int:
     return status
 
 
+def cmd_examples(args: argparse.Namespace) -> int:
+    """List the shipped problems, each as the command that runs it by name."""
+    from design.io.files import PROBLEMS
+    from design.io.scene import examples
+
+    print(f"Shipped problems, in {PROBLEMS}. Each runs by its name from any folder "
+          f"(a file of that name in the working folder comes first):")
+    for path, kind, summary in examples():
+        print(f"\n  design {'solve' if kind == 'design' else 'simulate'} {path.name}\n"
+              f"      {summary}")
+    return EXIT_OK
+
+
 def _lazy(module: str, name: str):
     """A command's function, imported only when the command runs."""
     def command(args: argparse.Namespace) -> int:
@@ -139,6 +152,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("check", help="validate input files and report every problem")
     p.add_argument("files", nargs="+", help="scene, problem or model files (YAML)")
     p.set_defaults(func=cmd_check)
+    p = sub.add_parser("examples", help="list the shipped problems, each with its description")
+    p.set_defaults(func=cmd_examples)
     return parser
 
 

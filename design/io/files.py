@@ -8,8 +8,32 @@ import yaml
 
 from design.io.reader import Reader
 
-#: the folder holding design/, models/ and problems/ in a checkout
-TOOLKIT_ROOT = Path(__file__).resolve().parents[2]
+
+def _shipped_root() -> Path:
+    """Where the shipped ``models/`` and ``problems/`` are: ``design/shipped/``
+    in an installed package (setup.py puts them there), else the checkout's
+    root beside ``design/`` (an editable install or a clone)."""
+    installed = Path(__file__).resolve().parents[1] / "shipped"
+    return installed if installed.is_dir() else Path(__file__).resolve().parents[2]
+
+
+#: the folder holding the shipped models/ and problems/
+TOOLKIT_ROOT = _shipped_root()
+#: the shipped scene and problem files
+PROBLEMS = TOOLKIT_ROOT / "problems"
+
+
+def find_scene(name: str | Path) -> Path:
+    """A scene or problem file as named on the command line: a path from the
+    working directory; failing that, a bare name (``hold_time.yaml`` or
+    ``hold_time``) among the shipped :data:`PROBLEMS`."""
+    path = Path(name)
+    if path.exists() or path.name != str(name):
+        return path
+    for candidate in (PROBLEMS / path.name, PROBLEMS / f"{path.name}.yaml"):
+        if candidate.is_file():
+            return candidate
+    return path
 
 
 def load_yaml(path: Path, reader: Reader, field: str = "") -> object | None:

@@ -9,14 +9,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
+import yaml
+
 from design.errors import ProblemFileError
 from design.io.beam_scene import read_beam
 from design.io.contact_scene import read_contact
 from design.io.design_problem import read_design
 from design.io.grasp_scene import MODEL_READERS, read_grasp
 from design.io.fingers import read_finger
-from design.io.files import load_yaml
-from design.io.reader import Reader
+from design.io.files import PROBLEMS, find_scene, load_yaml
+from design.io.reader import Reader, did_you_mean
 
 #: kind -> (required top-level keys, optional top-level keys, reader)
 KINDS = {
@@ -70,11 +72,28 @@ def check_file(source: str | Path | Mapping) -> object:
     return load_scene(source)
 
 
+def examples() -> list[tuple[Path, str, str]]:
+    """The shipped problems, by file name: (file, kind, the first sentence of
+    its description)."""
+    found = []
+    for path in sorted(PROBLEMS.glob("*.yaml")):
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+        summary = " ".join(data.get("description", "").split()).split(". ")[0].rstrip(".")
+        found.append((path, data["kind"], summary + "."))
+    return found
+
+
 def _open(source: str | Path | Mapping) -> tuple[Reader, dict | None, Path, str]:
     if isinstance(source, Mapping):
         return Reader("<scene>"), dict(source), Path.cwd(), "scene"
-    path = Path(source)
-    reader = Reader(str(source))
+    path = find_scene(source)
+    reader = Reader(str(path))
+    if not path.exists() and path.name == str(source):      # a bare name, found nowhere
+        shipped = [p.name for p in PROBLEMS.glob("*.yaml")]
+        reader.add("", f"no such file in {Path.cwd()} nor among the shipped problems "
+                       f"({PROBLEMS}; 'design examples' lists them)"
+                       f"{did_you_mean(path.name, shipped)}")
+        return reader, None, Path.cwd(), path.stem
     data = load_yaml(path, reader)
     if data is None and reader.ok:
         reader.add("", "the file is empty")
