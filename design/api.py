@@ -30,10 +30,20 @@ RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run, GraspScene: g
            DesignProblem: solve_run.run}
 
 
+def run(scene: object, source: str | Path | Mapping, progress: Progress | None = None
+        ) -> RunOutput:
+    """Run a validated scene read from ``source``; a file's name, as given,
+    is kept in the result as ``scene_file`` (the report's command to rerun it)."""
+    output = RUNNERS[type(scene)](scene, progress)
+    if not isinstance(source, Mapping):
+        output.result["scene_file"] = str(source)
+    return output
+
+
 def run_scene(source: str | Path | Mapping, progress: Progress | None = None) -> RunOutput:
     """Validate and run a scene; the full output (result and CSV tables)."""
     scene = load_scene(source)
-    return RUNNERS[type(scene)](scene, progress)
+    return run(scene, source, progress)
 
 
 def simulate(source: str | Path | Mapping, out: str | Path | None = None,

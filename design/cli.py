@@ -43,7 +43,7 @@ def output_folder(given: str | None, default: Path) -> Path | None:
 
 
 def cmd_simulate(args: argparse.Namespace) -> int:
-    from design.api import RUNNERS
+    from design.api import run
     from design.io.design_problem import DesignProblem
     from design.report import write_run
     from design.io.scene import load_scene
@@ -61,7 +61,7 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     out = output_folder(args.out, Path("reports") / (scene.name or Path(args.scene).stem))
     if out is None:
         return EXIT_BAD_INPUT
-    output = RUNNERS[type(scene)](scene, None if args.quiet else _progress)
+    output = run(scene, args.scene, None if args.quiet else _progress)
     written = write_run(out, output)
     for path in written:
         print(path)

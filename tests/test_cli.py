@@ -176,3 +176,42 @@ def test_a_manifest_never_removes_files_outside_its_folder(tmp_path):
     assert record_outputs(out, [out / "new.csv"]) == [out / "old.csv"]
     assert outside.read_text() == "keep" and not (out / "old.csv").exists()
     assert (out / MANIFEST).read_text() == "new.csv\n"
+
+
+def _footer_command(report: Path) -> str:
+    text = report.read_text()
+    return text[text.index("Command: ") + len("Command: "):].split("</p>")[0]
+
+
+def test_the_report_gives_the_command_that_reruns_its_scene_file(tmp_path, monkeypatch):
+    """Issue 12, item 10: the footer names the scene file as it was given (not
+    `<name>.yaml`, which need not exist), so the command works where the run did."""
+    monkeypatch.chdir(ROOT)
+    scene = tmp_path / "my scene.yaml"
+    scene.write_text((ROOT / "problems" / "beam_table_2_1.yaml").read_text())  # name: beam_table_2_1
+    out = tmp_path / "out"
+    assert main(["simulate", str(scene), "--out", str(out), "--quiet"]) == 0
+    assert json.loads((out / "result.json").read_text())["scene_file"] == str(scene)
+    assert _footer_command(out / "report.html") == f"design simulate {scene}"
+    assert main(["simulate", "problems/contact_case1.yaml", "--out", str(out), "--quiet"]) == 0
+    command = _footer_command(out / "report.html").split()
+    assert command == ["design", "simulate", "problems/contact_case1.yaml"]
+    assert main(["check", command[2]]) == 0                       # from the checkout root
+
+
+def test_a_design_reports_footer_says_design_solve():
+    from design.report.grasp import reproduce_section
+    from design.report.page import Page
+
+    page = Page("t")
+    reproduce_section(page, {"kind": "design", "toolkit_version": "0", "scene_file":
+                             "problems/hold_time.yaml"}, [], 1.0)
+    assert "Command: design solve problems/hold_time.yaml</p>" in page.render()
+
+
+def test_a_scene_given_as_content_has_no_command(tmp_path):
+    scene = {"kind": "beam", "finger": {"length": 0.2, "EI": 0.08},
+             "load": {"F": 15, "alpha": 1.5, "at": 0.1}}
+    assert "scene_file" not in design.simulate(scene, out=tmp_path)
+    assert "The scene was given as content from Python, not as a file." in (
+        tmp_path / "report.html").read_text()

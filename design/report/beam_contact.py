@@ -64,7 +64,7 @@ def beam_page(result: dict) -> Page:
     for ax in (shape, moment):
         ax.grid(alpha=0.3)
     page.figure(fig, "deflection", caption)
-    reproduce_section(page, result, f"design simulate {result['name']}.yaml",
+    reproduce_section(page, result,
                       [{"setting": k, "value": str(v)} for k, v in result["solver"].items()],
                       result["solve_time_s"])
     return page
@@ -106,7 +106,7 @@ def contact_page(result: dict) -> Page:
         ax.grid(alpha=0.3)
     page.figure(fig, "contact", "Contact force against finger angle; the finger and the object "
                 "at a selection of poses (drum frame)")
-    reproduce_section(page, result, f"design simulate {result['name']}.yaml",
+    reproduce_section(page, result,
                       [{"setting": k, "value": str(v)} for k, v in result["solver"].items()],
                       result["solve_time_s"])
     return page

@@ -127,6 +127,5 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     settings = [{"setting": k, "value": str(val)} for k, val in s["settings"].items()]
     settings += [{"setting": "Ipopt iterations (all)", "value": str(s["iterations"])},
                  {"setting": "NLP size", "value": str(s["nlp_size"])}]
-    reproduce_section(page, result, f"design solve {result['name']}.yaml", settings,
-                      result["wall_time_s"])
+    reproduce_section(page, result, settings, result["wall_time_s"])
     return page

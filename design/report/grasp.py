@@ -73,15 +73,20 @@ def grasp_page(result: dict, run: GraspRun) -> Page:
     page.section("Summary", "summary")
     page.table(summary_rows(run), "Run summary (SI)", "summary-table")
     grasp_figures(page, {"": run})
-    reproduce_section(page, result, f"design simulate {result['name']}.yaml",
+    reproduce_section(page, result,
                       [{"setting": k, "value": v} for k, v in result["solver"].items()],
                       result["stats"]["wall_time_s"])
     return page
 
 
-def reproduce_section(page: Page, result: dict, command: str, settings: list[dict],
-                      wall_time: float) -> None:
+def reproduce_section(page: Page, result: dict, settings: list[dict], wall_time: float) -> None:
+    """The report's last section: version, wall time (s), the command that
+    reruns the run (its scene file as it was named) and the solver settings."""
+    verb = "solve" if result["kind"] == "design" else "simulate"
+    scene = result.get("scene_file")
+    command = (f"Command: design {verb} {scene}" if scene else
+               "The scene was given as content from Python, not as a file.")
     page.section("Reproduce this run", "reproduce")
     page.text(f"Toolkit version {result['toolkit_version']}; wall time {wall_time:.1f} s. "
-              f"Command: {command}")
+              f"{command}")
     page.table(settings, "Solver settings", "settings-table")
