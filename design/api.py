@@ -73,8 +73,9 @@ def solve(source: str | Path | Mapping, out: str | Path | None = None,
     """Solve a design problem (``kind: design``, a path or the file's content):
     optimise, verify, and return the dict ``design solve`` writes to
     ``result.json`` (with ``out``, also write it, the CSV tables,
-    ``optimum.yaml`` and ``report.html`` there). ``result["verification"]["passed"]`` says
-    whether the independent simulation confirmed the design."""
+    ``optimum.yaml`` and ``report.html`` there). ``result["status"]`` says how
+    it ended: ``verified``, ``no improvement found`` (the baseline is the
+    answer), ``failed verification`` or ``error`` (design/run/solve.py)."""
     scene = load_scene(source)
     if not isinstance(scene, DesignProblem):
         raise ValueError("design.solve needs a design problem (kind: design); "

@@ -1,7 +1,8 @@
 """The ``design`` command.
 
 Exit status: 0 success; 1 the run finished but did not succeed (a case did
-not converge, a verification failed); 2 bad input (nothing was written).
+not converge, a verification failed, an error); 2 bad input (nothing was
+written).
 """
 
 from __future__ import annotations
@@ -67,10 +68,9 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(path)
     r = output.result
     if r.get("kind") == "design":
-        v, b = r["verification"], r["baseline"]
-        print(f"{r['status']}: hold {v['hold_time_s']:.4f} s verified (optimiser "
-              f"{r['objective']['hold_time_s']:.4f} s; baseline {b['hold_time_s']:.4f} s), peak "
-              f"finger force {v['max_finger_force_N']:.2f} N (cap {v['cap_N']:.2f} N)")
+        from design.run.solve import status_line
+
+        print(status_line(r))
     if not output.ok:
         if output.result.get("kind") == "design":
             print(f"FAILED: {output.result['status']}: {output.result['message']}",

@@ -115,13 +115,15 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
     assert main(["solve", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1
     assert "FAILED" in capsys.readouterr().err
     result = json.loads((tmp_path / "out" / "result.json").read_text())
-    assert result["status"] == "infeasible" and not result["verification"]["passed"]
+    assert result["status"] == "failed verification" and not result["verification"]["passed"]
+    assert result["message"].startswith("infeasible: no design within the bounds")
     assert result["verification"]["max_finger_force_N"] > result["verification"]["cap_N"]
     assert (tmp_path / "out" / "optimum.yaml").exists()
     # the report says so first: its first block after the title is the red banner
     report = (tmp_path / "out" / "report.html").read_text(encoding="utf-8")
     body = report[report.index("</nav>"):]
-    assert body.index('<div class="banner failed" id="verdict">FAILED (infeasible)') < \
+    assert body.index('<div class="banner failed" id="verdict">FAILED VERIFICATION: '
+                      'infeasible') < \
         body.index("<h2")
 
 

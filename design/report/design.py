@@ -71,17 +71,22 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     page = Page(f"Design: {result['name']}")
     v, b = result["verification"], result["baseline"]
     ratio = v["hold_time_s"] / b["hold_time_s"] if b["hold_time_s"] > 0 else float("inf")
-    if v["passed"] and v.get("model_warnings"):
+    status = result["status"]
+    if status == "no improvement found":
+        page.banner(f"NO IMPROVEMENT FOUND: {result['message']} (hold {v['hold_time_s']:.4f} "
+                    f"s, peak finger force {v['max_finger_force_N']:.2f} N, cap "
+                    f"{v['cap_N']:.2f} N).", "neutral")
+    elif status == "verified" and v.get("model_warnings"):
         page.banner(f"VERIFIED BY A MODEL OUTSIDE ITS VALIDITY: hold {v['hold_time_s']:.4f} s "
                     f"({ratio:.2f}x the baseline's {b['hold_time_s']:.4f} s), peak finger force "
                     f"{v['max_finger_force_N']:.2f} N under the {v['cap_N']:.2f} N cap; "
                     f"{'; '.join(v['model_warnings'])}.", "failed")
-    elif v["passed"]:
+    elif status == "verified":
         page.banner(f"VERIFIED: hold {v['hold_time_s']:.4f} s ({ratio:.2f}x the baseline's "
                     f"{b['hold_time_s']:.4f} s), peak finger force {v['max_finger_force_N']:.2f} N "
                     f"under the {v['cap_N']:.2f} N cap: {result['message']}.", "passed")
     else:
-        page.banner(f"FAILED ({result['status']}): {result['message']}. Do not use this "
+        page.banner(f"{status.upper()}: {result['message']}. Do not use this "
                     "design without reading the verification table.", "failed")
     page.section("The problem", "problem")
     page.text(result.get("description") or "")

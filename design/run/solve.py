@@ -1,4 +1,14 @@
-"""Running a design problem: optimise, verify, tabulate (``design solve``)."""
+"""Running a design problem: optimise, verify, tabulate (``design solve``).
+
+A run ends in one of four statuses (result.json's ``status``; the command's
+exit status in brackets): ``verified`` (0), the independent simulation
+confirms the optimiser's design; ``no improvement found`` (0), the loop
+accepted no design and the baseline, which keeps the cap, is the answer;
+``failed verification`` (1), the simulation disagrees with the optimiser or
+the design breaks the cap; ``error`` (1), the optimiser could not work
+(every NLP failed, or it could not evaluate its own design). Bad input (2)
+and Ctrl-C (130) write no result.
+"""
 
 from __future__ import annotations
 
@@ -20,6 +30,9 @@ from design.solve.optimize.variables import (DesignSpace, Variable, parameters_o
 
 #: a scaled variable this close to 0 or 1 sits on its bound
 ACTIVE = 1e-3
+#: how a run ends; the first two are a success (exit status 0)
+VERIFIED, NO_IMPROVEMENT = "verified", "no improvement found"
+FAILED, ERROR = "failed verification", "error"
 
 
 def design_space(problem: DesignProblem, progress: Progress | None = None) -> DesignSpace:
@@ -65,6 +78,7 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
         start = outcome.best.d
     entries = [entries[k] for k in range(len(caps))]
     primary, (outcome, fine) = entries[0], outcomes[0]
+    status, message = overall_status(entries)
     result = {
         "kind": "design", "name": problem.name, "toolkit_version": __version__,
         "units": {"length": "m", "force": "N", "angle": "rad", "time": "s",
@@ -74,7 +88,7 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
                                            "unit": v.unit} for v in space.variables},
                     "caps": [c.describe() for c in problem.caps],
                     "rules": vars(problem.rules)},
-        **primary,
+        **primary, "status": status, "message": message,
         "baseline": {"hold_time_s": baseline.hold,
                      "hold_windows": baseline.run.summary["hold_windows"],
                      "max_finger_force_N": baseline.peak,
@@ -87,13 +101,42 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
     tables = {"design.csv": primary["variables"], "timeseries.csv": timeseries(fine.run)}
     if problem.pareto:
         tables["pareto.csv"] = result["pareto"]
-    spec = grasp_spec(space.setup(outcome.best.d), problem.scene.settings,
-                      f"{problem.name}_optimum",
-                      f"Optimised by design solve from {problem.name} (cap "
-                      f"{primary['verification']['cap_N']:.3g} N).")
-    return RunOutput(result, tables, ok=all(e["verification"]["passed"] for e in entries),
-                     files={"optimum.yaml": scene_yaml(spec)},
+    files = {}
+    if primary["status"] in (VERIFIED, FAILED):        # else the baseline: no optimum
+        spec = grasp_spec(space.setup(outcome.best.d), problem.scene.settings,
+                          f"{problem.name}_optimum",
+                          f"Optimised by design solve from {problem.name} (cap "
+                          f"{primary['verification']['cap_N']:.3g} N).")
+        files["optimum.yaml"] = scene_yaml(spec)
+    return RunOutput(result, tables, ok=status in (VERIFIED, NO_IMPROVEMENT), files=files,
                      artifacts={"baseline": baseline.run, "optimum": fine.run})
+
+
+def overall_status(entries: list[dict]) -> tuple[str, str]:
+    """The run's status and message: the first cap's (whose design the
+    result reports), unless another cap ended in an error or failed."""
+    worst = next((s for s in (ERROR, FAILED) if s in [e["status"] for e in entries]),
+                 entries[0]["status"])
+    entry = next(e for e in entries if e["status"] == worst)
+    if entry is entries[0]:
+        return worst, entry["message"]
+    return worst, f"cap {entry['cap']['N']:.2f} N: {entry['message']}"
+
+
+def status_line(result: dict) -> str:
+    """The command's closing line for a design result: its status and numbers."""
+    v, b, status = result["verification"], result["baseline"], result["status"]
+    peak = f"peak finger force {v['max_finger_force_N']:.2f} N (cap {v['cap_N']:.2f} N)"
+    if status == ERROR:
+        return f"error: {result['message']}"
+    if status == NO_IMPROVEMENT:
+        return (f"no improvement found: the design is the baseline, unchanged; hold "
+                f"{v['hold_time_s']:.4f} s, {peak}")
+    caveat = " (by a model outside its validity)" if status == VERIFIED and \
+        v["model_warnings"] else ""
+    return (f"{status}{caveat}: hold {v['hold_time_s']:.4f} s in the independent simulation "
+            f"(optimiser {result['objective']['hold_time_s']:.4f} s; baseline "
+            f"{b['hold_time_s']:.4f} s), {peak}")
 
 
 def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, fine, cap,
@@ -106,25 +149,7 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
                   "baseline": v.baseline, "optimum": v.lo + d[i] * (v.hi - v.lo),
                   "active_bound": "lower" if d[i] < ACTIVE else "upper" if d[i] > 1 - ACTIVE
                   else ""} for i, v in enumerate(space.variables)]
-    if check["passed"] and check["model_warnings"]:
-        status = "verified by a model outside its validity"
-        message = ("the independent simulation confirms the design, but the grasp model is "
-                   "outside its validity: " + "; ".join(check["model_warnings"]))
-    elif check["passed"]:
-        status, message = "verified", "the independent simulation confirms the design"
-    elif not np.isfinite(claimed):
-        status = "optimiser failed"
-        errors = list(dict.fromkeys(i.get("error") or i.get("ipopt_status", "")
-                                    for i in outcome.iterations))
-        message = "no optimisation step could be computed: " + "; ".join(errors)
-    elif not outcome.feasible:
-        status = "infeasible"
-        message = _diagnosis(space, problem, best, cap, variables)
-    else:
-        status = "failed verification"
-        message = (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "
-                   f"optimiser's {claimed:.4f} s, peak {fine.peak:.2f} N against the "
-                   f"cap {cap:.2f} N")
+    status, message = _status(space, problem, outcome, claim, check, fine, variables)
     iterations = outcome.iterations
     return {
         "status": status, "message": message,
@@ -159,6 +184,37 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
                          "ipopt": problem.settings.nlp.ipopt},
         },
     }
+
+
+def _status(space, problem, outcome: Outcome, claim, check, fine, variables
+            ) -> tuple[str, str]:
+    """One cap's status (see the module's docstring) and why."""
+    claimed, source = claim
+    cap = outcome.cap
+    errors = outcome.errors
+    failures = f" ({len(errors)} NLP failure(s): {'; '.join(errors)})" if errors else ""
+    keeps_cap = check["max_finger_force_N"] <= cap * (1 + check["cap_tolerance"])
+    if outcome.every_nlp_failed:
+        return ERROR, ("every NLP of the design loop failed, so no design was tried; the "
+                       "baseline is unchanged and not an answer: " + "; ".join(errors))
+    if outcome.best is outcome.baseline and keeps_cap:
+        return NO_IMPROVEMENT, ("the design loop found no design that holds longer under "
+                                "the cap; the design reported is the baseline, unchanged"
+                                + failures)
+    if check["passed"] and check["model_warnings"]:
+        return VERIFIED, ("verified by a model outside its validity: the independent "
+                          "simulation confirms the design, but the grasp model is outside "
+                          "its validity: " + "; ".join(check["model_warnings"]))
+    if check["passed"]:
+        return VERIFIED, "the independent simulation confirms the design"
+    if not np.isfinite(claimed):
+        return ERROR, (f"the optimiser could not evaluate its own design ({source}), so it "
+                       f"cannot be verified{failures}")
+    if not outcome.feasible:
+        return FAILED, "infeasible: " + _diagnosis(space, problem, outcome.best, cap, variables)
+    return FAILED, (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "
+                    f"optimiser's {claimed:.4f} s, peak {fine.peak:.2f} N against the "
+                    f"cap {cap:.2f} N")
 
 
 def _diagnosis(space, problem, best, cap, variables) -> str:

@@ -64,13 +64,16 @@ def study(problem: DesignProblem, quick: bool = False, progress: Progress | None
         say(f"design: fixed-design NLP on a {1e3 * nlp.time_step:g} ms grid, "
             f"{nlp.beam_intervals} beam intervals")
         t0 = time.perf_counter()
-        view = optimiser_view(space, base, replace(loop, nlp=nlp), problem.rules)
+        try:
+            view, error = optimiser_view(space, base, replace(loop, nlp=nlp), problem.rules), ""
+        except (RuntimeError, ValueError) as exc:
+            view, error = None, str(exc)
         wall = time.perf_counter() - t0
         hold = view.hold_time if view is not None else math.nan
         violation = view.history[-1]["violation"] if view is not None and view.history \
             else math.nan
         note = "" if feasible(view) else \
-            "the NLP could not be built or evaluated" if view is None else \
+            f"the NLP could not be built or solved: {error}" if view is None else \
             f"not feasible: constraint violation {violation:.3g} > {VIEW_FEASIBLE:g}"
         rows.append(Row(
             "design", "fixed-design NLP", f"{1e3 * nlp.time_step:g} ms grid, "

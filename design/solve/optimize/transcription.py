@@ -81,6 +81,19 @@ class Rules:
     finger_sets: int | None = None
 
 
+#: Ipopt's return statuses that end a solve on an error, not at an iterate it
+#: judged (converged, stopped by a limit, or found infeasible): an exception
+#: in an evaluation or a callback, a NaN at the iterate, an invalid problem
+IPOPT_ERRORS = frozenset({
+    "Not_Enough_Degrees_Of_Freedom", "Invalid_Problem_Definition", "Invalid_Option",
+    "Invalid_Number_Detected", "Unrecoverable_Exception", "NonIpopt_Exception_Thrown",
+    "Insufficient_Memory", "Internal_Error"})
+
+
+class NLPFailed(RuntimeError):
+    """Ipopt ended on an error (one of :data:`IPOPT_ERRORS`): no iterate to use."""
+
+
 @dataclass
 class NLPResult:
     d: np.ndarray
@@ -320,6 +333,12 @@ class DesignNLP:
             sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         wall = time.perf_counter() - t0
         stats = solver.stats()
+        if callback.error is not None:
+            raise NLPFailed(f"Ipopt's iteration callback failed: {callback.error!r}") \
+                from callback.error
+        if stats["return_status"] in IPOPT_ERRORS:
+            raise NLPFailed(f"Ipopt ended on an error, {stats['return_status']}, after "
+                            f"{stats['iter_count']} iterations")
         x = np.asarray(sol["x"]).ravel()
         n, m = self.n_design, self.n_phases
         try:
@@ -384,7 +403,8 @@ def rule_constraints(values: dict, setup, rules: Rules):
 
 
 class _Progress(ca.Callback):
-    """Ipopt iteration callback: records and reports objective and violation."""
+    """Ipopt iteration callback: records and reports objective and violation;
+    stops Ipopt when the view has stalled."""
 
     def __init__(self, nlp: DesignNLP, history: list, progress):
         ca.Callback.__init__(self)
@@ -394,6 +414,8 @@ class _Progress(ca.Callback):
         self.hold_index = nlp.n_design + nlp.schedule.hold
         self.stall = nlp.settings.stall_iterations, nlp.settings.stall_violation
         self.streams = sys.stdout, sys.stderr
+        #: an exception in the callback, which ends the solve as an error
+        self.error: Exception | None = None
         self.construct("progress", {})
 
     def get_n_in(self):
@@ -419,6 +441,15 @@ class _Progress(ca.Callback):
         return ca.Sparsity(0, 0)
 
     def eval(self, arg):
+        try:
+            self._record(arg)
+        except Exception as exc:      # noqa: BLE001  CasADi would take it for a stop request
+            self.error = exc
+            return [1]
+        # non-zero: Ipopt stops (User_Requested_Stop)
+        return [int(self.stalled())]
+
+    def _record(self, arg) -> None:
         g = np.asarray(arg[ca.nlpsol_out().index("g")]).ravel()
         hold = float(arg[ca.nlpsol_out().index("x")][self.hold_index])
         violation = float(np.max(np.concatenate([[0.0], self.lbg - g, g - self.ubg])))
@@ -432,7 +463,6 @@ class _Progress(ca.Callback):
                             f"{hold:.4f} s, constraint violation {violation:.2e}")
             finally:
                 sys.stdout, sys.stderr = muted
-        return [int(self.stalled())]          # non-zero: Ipopt stops (User_Requested_Stop)
 
     def stalled(self) -> bool:
         n, floor = self.stall

@@ -112,6 +112,18 @@ class Outcome:
     def feasible(self) -> bool:
         return self.best.peak <= self.cap * (1 + CAP_TOLERANCE)
 
+    @property
+    def every_nlp_failed(self) -> bool:
+        """Did every outer iteration's NLP fail (raise, or end on an Ipopt
+        error), so that the loop never had a design to try?"""
+        return bool(self.iterations) and all("error" in i for i in self.iterations)
+
+    @property
+    def errors(self) -> list[str]:
+        """The distinct errors of the loop's NLPs and views, in order."""
+        return list(dict.fromkeys(e for i in self.iterations
+                                  for e in (i.get("error"), i.get("view_error")) if e))
+
 
 def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
              integrator: IntegratorSettings | None = None) -> Evaluated:
@@ -164,10 +176,13 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
             continue
         candidate = simulate(space, result.d, settings)
         accepted = better(candidate, best, cap)
-        reproduced, view = None, None
+        reproduced, view, view_error = None, None, None
         if accepted:
             # stand only on designs whose simulation the optimiser's grid reproduces
-            view = optimiser_view(space, candidate, settings, rules, progress)
+            try:
+                view = optimiser_view(space, candidate, settings, rules, progress)
+            except (RuntimeError, ValueError) as exc:
+                view_error = f"the fixed-design NLP failed: {exc}"
             claim = optimiser_hold(view, result)
             reproduced = reproduces(candidate, claim[0])
             accepted = reproduced
@@ -177,7 +192,7 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
             "nlp_wall_time_s": result.wall_time, "nlp_hold_time_s": result.hold_time,
             "nlp_peak_force_N": result.peak_force, "simulated_hold_time_s": candidate.hold,
             "simulated_peak_force_N": candidate.peak, "accepted": accepted,
-            "grid_reproduces_simulation": reproduced,
+            "grid_reproduces_simulation": reproduced, "view_error": view_error,
             "view": None if view is None else {
                 "ipopt_status": view.status, "ipopt_iterations": view.iterations,
                 "wall_time_s": view.wall_time, "hold_time_s": view.hold_time,
@@ -229,21 +244,24 @@ def optimiser_hold(view: NLPResult | None, accepted: NLPResult | None) -> tuple[
 
 
 def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSettings,
-                   rules: Rules = Rules(), progress=None) -> NLPResult | None:
+                   rules: Rules = Rules(), progress=None) -> NLPResult:
     """The hold time on the optimiser's grid for a fixed design: the NLP with
-    the design's bounds collapsed onto it, on its own simulated schedule
-    (None if it cannot be built or evaluated there)."""
+    the design's bounds collapsed onto it, on its own simulated schedule.
+
+    Raises
+    ------
+    RuntimeError, ValueError
+        If the NLP cannot be built or evaluated there, or Ipopt ends on an
+        error (:class:`~design.solve.optimize.transcription.NLPFailed`).
+    """
     schedule = schedule_of(evaluated.run, settings.nlp.time_step)
     # only durations and states move: allow more iterations, but stop one that
     # has stalled above feasibility (it would not reproduce the design anyway)
     nlp_settings = replace(settings.nlp, max_iter=max(settings.nlp.max_iter, VIEW_MAX_ITER),
                            stall_iterations=VIEW_STALL, stall_violation=VIEW_FEASIBLE)
-    try:
-        nlp = DesignNLP(space, schedule, evaluated.run, np.inf, nlp_settings, rules,
-                        (evaluated.d, evaluated.d), progress, objective="track")
-        return nlp.solve()
-    except (RuntimeError, ValueError):
-        return None
+    nlp = DesignNLP(space, schedule, evaluated.run, np.inf, nlp_settings, rules,
+                    (evaluated.d, evaluated.d), progress, objective="track")
+    return nlp.solve()
 
 
 def reproduces(evaluated: Evaluated, claimed: float) -> bool:
@@ -259,8 +277,12 @@ def certify(space: DesignSpace, outcome: Outcome, settings: LoopSettings,
     if outcome.claim is None:
         (progress or (lambda message: None))("the optimiser's view of the design on its "
                                              "own schedule")
-        outcome.final = optimiser_view(space, outcome.best, settings, rules, progress)
-        outcome.claim = optimiser_hold(outcome.final, outcome.nlp)
+        try:
+            outcome.final = optimiser_view(space, outcome.best, settings, rules, progress)
+        except (RuntimeError, ValueError) as exc:
+            outcome.claim = float("nan"), f"none: the fixed-design NLP failed ({exc})"
+        else:
+            outcome.claim = optimiser_hold(outcome.final, outcome.nlp)
     return outcome.claim
 
 

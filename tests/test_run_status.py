@@ -1,0 +1,135 @@
+"""How a design run ends when its optimiser fails or finds nothing: every NLP
+failing is an error (exit 1), never the baseline reported as verified; a
+loop that improves nothing says so (exit 0, the baseline labelled as such).
+
+The loop's decisions are under test, not the physics: every design
+simulates to one run of the short test grasp (tests/design_cases.py)."""
+
+import json
+
+import numpy as np
+import pytest
+
+from design.cli import main
+from design.io.grasp_scene import GraspSettings
+from design.io.scene_writer import grasp_spec
+from design.run.solve import ERROR, FAILED, NO_IMPROVEMENT, VERIFIED, overall_status
+from design.solve.grasp.simulation import simulate_grasp
+from design.solve.optimize.transcription import DesignNLP, NLPResult
+from tests.design_cases import short_setup
+
+
+@pytest.fixture(scope="module")
+def one_run():
+    return simulate_grasp(short_setup())
+
+
+@pytest.fixture
+def problem(tmp_path, one_run, monkeypatch):
+    """A design problem on the short grasp whose every simulation is ``one_run``."""
+    monkeypatch.setattr("design.solve.optimize.trust_region.simulate_grasp",
+                        lambda *args, **kwargs: one_run)
+    scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
+    path = tmp_path / "problem.yaml"
+    path.write_text(json.dumps({
+        "kind": "design", "scene": scene, "cap": "baseline",
+        "variables": {"groups.lower.stiffness_scale": [0.5, 2.0]},
+        "solver": {"time_step": 0.01, "max_iter": 5, "outer_iterations": 2}}))
+    return path
+
+
+def solve(problem, capsys):
+    out = problem.parent / "out"
+    code = main(["solve", str(problem), "--out", str(out), "--quiet"])
+    stdout, stderr = capsys.readouterr()
+    result = json.loads((out / "result.json").read_text())
+    report = (out / "report.html").read_text(encoding="utf-8")
+    return code, result, stdout.strip().splitlines()[-1], stderr, report, out
+
+
+class NoBetterNLP:
+    """An NLP that converges to the middle of its box: its design simulates
+    to the baseline's run, so no candidate holds longer."""
+
+    def __init__(self, space, schedule, run, cap, settings, rules=None, box=None,
+                 progress=None, objective="hold"):
+        self.d = (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
+        self.hold = run.summary["hold_time_s"]
+
+    def solve(self):
+        history = [{"iteration": 0, "hold_time_s": self.hold, "violation": 0.0}]
+        return NLPResult(self.d, np.zeros(1), self.hold, 0.0, "Solve_Succeeded", True, 1,
+                         0.0, {"variables": 1}, history, self.d, np.zeros(0), np.zeros(0))
+
+
+class IpoptEndsOnAnError:
+    """Ipopt as CasADi returns it when an evaluation threw (the status an
+    interrupted solve used to end with)."""
+
+    def __init__(self, *args, **kwargs):
+        pass
+
+    def __call__(self, x0, **bounds):
+        return {"x": x0, "lam_g": 0.0, "lam_x": 0.0}
+
+    def stats(self):
+        return {"return_status": "NonIpopt_Exception_Thrown", "iter_count": 3,
+                "success": False}
+
+
+def failing_nlps(how):
+    """Every design-moving NLP fails (``how``); the optimiser's view of a
+    fixed design works, so the baseline would verify (the reported bug)."""
+    def nlp(*args, objective="hold", **kwargs):
+        if objective == "track":
+            return NoBetterNLP(*args, **kwargs)
+        if how == "raises":
+            raise RuntimeError("the NLP cannot be built here")
+        return DesignNLP(*args, **kwargs)
+    return nlp
+
+
+@pytest.mark.parametrize("how", ["raises", "Ipopt error status"])
+def test_every_nlp_failing_is_an_error_not_a_verified_baseline(problem, monkeypatch, capsys,
+                                                                how):
+    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", failing_nlps(how))
+    monkeypatch.setattr("design.solve.optimize.transcription.ca.nlpsol", IpoptEndsOnAnError)
+    code, result, last, stderr, report, out = solve(problem, capsys)
+    assert code == 1
+    assert result["status"] == ERROR
+    assert result["message"].startswith("every NLP of the design loop failed")
+    assert len(result["solver"]["history"]) == 2
+    assert all("error" in i for i in result["solver"]["history"])
+    expected = "cannot be built" if how == "raises" else "NonIpopt_Exception_Thrown"
+    assert expected in result["message"]
+    assert last.startswith("error: every NLP") and "FAILED: error" in stderr
+    assert '<div class="banner failed" id="verdict">ERROR: every NLP' in report
+    assert not (out / "optimum.yaml").exists()          # the baseline is no optimum
+
+
+def test_no_improvement_is_its_own_status_with_the_baseline_labelled(problem, monkeypatch,
+                                                                     capsys):
+    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", NoBetterNLP)
+    code, result, last, stderr, report, out = solve(problem, capsys)
+    assert code == 0
+    assert result["status"] == NO_IMPROVEMENT
+    assert result["design"] == result["baseline"]["design"]
+    assert [i["accepted"] for i in result["solver"]["history"]] == [False, False]
+    assert last.startswith("no improvement found: the design is the baseline, unchanged")
+    assert "FAILED" not in stderr
+    assert '<div class="banner neutral" id="verdict">NO IMPROVEMENT FOUND' in report
+    assert not (out / "optimum.yaml").exists()
+
+
+def entry(status, cap):
+    return {"status": status, "message": f"{status} at {cap}", "cap": {"N": cap}}
+
+
+def test_a_pareto_run_reports_its_worst_cap():
+    """The first cap's status unless another cap ended in an error or failed."""
+    assert overall_status([entry(VERIFIED, 20.0), entry(NO_IMPROVEMENT, 30.0)]) == \
+        (VERIFIED, "verified at 20.0")
+    assert overall_status([entry(NO_IMPROVEMENT, 20.0), entry(VERIFIED, 30.0)]) == \
+        (NO_IMPROVEMENT, "no improvement found at 20.0")
+    assert overall_status([entry(VERIFIED, 20.0), entry(FAILED, 30.0),
+                           entry(ERROR, 40.0)]) == (ERROR, "cap 40.00 N: error at 40.0")
