@@ -215,3 +215,28 @@ def test_a_scene_given_as_content_has_no_command(tmp_path):
     assert "scene_file" not in design.simulate(scene, out=tmp_path)
     assert "The scene was given as content from Python, not as a file." in (
         tmp_path / "report.html").read_text()
+
+
+def test_beam_shape_is_the_whole_finger_and_tip_is_the_load_point(tmp_path):
+    """Issue 12, item 10: `tip` is the load point (s = at); `shape` runs on to
+    the finger's free end, straight and moment-free past the load."""
+    import numpy as np
+    import yaml
+
+    result = design.simulate(ROOT / "problems" / "beam_table_2_3.yaml", out=tmp_path)
+    length, case = result["finger"]["length"], result["cases"][0]
+    shape = {k: np.array(v) for k, v in case["shape"].items()}
+    assert case["at"] < length and shape["s"][-1] == length
+    at = int(np.flatnonzero(shape["s"] == case["at"])[0])
+    assert [shape[k][at] for k in ("x", "y", "psi")] == [case["tip"][k] for k in ("x", "y", "psi")]
+    beyond = slice(at, None)
+    np.testing.assert_array_equal(shape["psi"][beyond], case["tip"]["psi"])
+    np.testing.assert_allclose(shape["M"][beyond], 0.0, atol=1e-12)
+    run = np.hypot(shape["x"][-1] - shape["x"][at], shape["y"][-1] - shape["y"][at])
+    assert run == pytest.approx(length - case["at"], rel=1e-12)
+    rows = list(csv.DictReader((tmp_path / "shapes.csv").open()))
+    assert float(rows[-1]["s_m"]) == pytest.approx(length)
+    scene = yaml.safe_load((ROOT / "problems" / "beam_table_2_3.yaml").read_text())
+    at_the_end = design.simulate({**scene, "load": {"F": 15, "alpha": "90 deg"}})["cases"][0]
+    assert at_the_end["shape"]["s"][-1] == at_the_end["at"] == length
+    assert at_the_end["shape"]["x"][-1] == at_the_end["tip"]["x"]

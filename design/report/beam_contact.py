@@ -51,7 +51,8 @@ def beam_page(result: dict) -> Page:
         moment.set_xlabel("arc length s (mm)")
         moment.set_ylabel("bending moment M (N m)")
         shape.legend(fontsize=8)
-        caption = "Deflected loaded part of the finger and its bending moment"
+        caption = ("The deflected finger from its clamp to its free end (straight past the "
+                   "load point) and its bending moment")
     else:
         force = [c["F"] for c in cases]
         shape.plot(force, [c["tip"]["y"] * MM for c in cases], ".")

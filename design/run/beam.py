@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import time
 
+import numpy as np
+
 from design import __version__
 from design.io.beam_scene import BeamScene
 from design.physics.beam import BeamSolution
@@ -11,14 +13,28 @@ from design.run import Progress, RunOutput
 from design.solve.beam import make_method
 
 
-def case_dict(sol: BeamSolution) -> dict:
-    """One load's result, SI units (m, N, rad, N m)."""
+def whole_finger(sol: BeamSolution, length: float) -> dict:
+    """The deflected finger from the clamp to its free end (s = ``length``, m):
+    the solution up to the load point, then one more point at the end, since
+    past the load the finger carries no moment and stays straight."""
+    s, x, y, psi, m = sol.s, sol.x, sol.y, sol.psi, sol.moment
+    rest = length - sol.load.at
+    if rest > 0:
+        s, psi, m = np.append(s, length), np.append(psi, psi[-1]), np.append(m, 0.0)
+        x = np.append(x, x[-1] + rest * np.cos(psi[-1]))
+        y = np.append(y, y[-1] + rest * np.sin(psi[-1]))
+    return {"s": s, "x": x, "y": y, "psi": psi, "M": m}
+
+
+def case_dict(sol: BeamSolution, length: float) -> dict:
+    """One load's result, SI units (m, N, rad, N m). ``tip`` is the load point
+    (s = ``at``); ``shape`` is the whole finger of ``length`` (m)."""
     fx, fy = sol.load.components
     x, y, psi = sol.tip
     return {
         "F": sol.load.force, "alpha": sol.load.alpha, "at": sol.load.at,
         "tip": {"x": x, "y": y, "psi": psi},
-        "shape": {"s": sol.s, "x": sol.x, "y": sol.y, "psi": sol.psi, "M": sol.moment},
+        "shape": whole_finger(sol, length),
         "error_estimate": sol.error_estimate, "converged": sol.converged,
         "branch": sol.branch, "multiple_equilibria": sol.multiple_equilibria,
         "iterations": sol.iterations, "message": sol.message,
@@ -33,7 +49,7 @@ def run(scene: BeamScene, progress: Progress | None = None) -> RunOutput:
     t0 = time.perf_counter()
     sols = method.solve(scene.loads)
     elapsed = time.perf_counter() - t0
-    cases = [case_dict(s) for s in sols]
+    cases = [case_dict(s, scene.finger.length) for s in sols]
     result = {
         "kind": "beam", "name": scene.name, "toolkit_version": __version__,
         "units": {"length": "m", "force": "N", "angle": "rad", "moment": "N m",
