@@ -13,6 +13,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
+from design import interrupt
 from design.io.beam_scene import BeamScene
 from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
@@ -41,9 +42,11 @@ def run(scene: object, source: str | Path | Mapping, progress: Progress | None =
 
 
 def run_scene(source: str | Path | Mapping, progress: Progress | None = None) -> RunOutput:
-    """Validate and run a scene; the full output (result and CSV tables)."""
+    """Validate and run a scene; the full output (result and CSV tables).
+    Ctrl-C raises :class:`design.errors.Interrupted` (see :mod:`design.interrupt`)."""
     scene = load_scene(source)
-    return run(scene, source, progress)
+    with interrupt.handled():
+        return run(scene, source, progress)
 
 
 def simulate(source: str | Path | Mapping, out: str | Path | None = None,
@@ -59,12 +62,16 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
         If the scene has problems (nothing is written then).
     design.io.results.OutputFolderError
         If ``out`` cannot be written to (checked before the run).
+    design.errors.Interrupted
+        On Ctrl-C (a ``KeyboardInterrupt``): nothing was written, or, if it
+        came while the files were being written, all of them were.
     """
     if out is not None:
         check_output_folder(Path(out))
-    output = run_scene(source, progress)
-    if out is not None:
-        write_run(Path(out), output)
+    with interrupt.handled():
+        output = run_scene(source, progress)
+        if out is not None:
+            write_run(Path(out), output)
     return output.result
 
 

@@ -2,7 +2,7 @@
 
 Exit status: 0 success; 1 the run finished but did not succeed (a case did
 not converge, a verification failed, an error); 2 bad input (nothing was
-written).
+written); 130 stopped by Ctrl-C (nothing was written, or every file was).
 """
 
 from __future__ import annotations
@@ -15,6 +15,8 @@ from design.errors import ProblemFileError
 from design import __version__
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
+#: 128 + SIGINT: what a shell reports for a command stopped by Ctrl-C
+EXIT_INTERRUPTED = 130
 
 
 def _progress(message: str) -> None:
@@ -158,8 +160,18 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    from design import interrupt
+
     args = build_parser().parse_args(argv)
-    return args.func(args)
+    try:
+        with interrupt.handled():
+            return args.func(args)
+    except BaseException as exc:      # whatever the Ctrl-C became on its way out
+        stopped = interrupt.stopped(exc)
+        if stopped is None:
+            raise
+        print(stopped, file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

@@ -39,3 +39,17 @@ class MethodUnsupportedError(ValueError):
     Raised instead of returning a wrong number, e.g. the Frisch-Fay closed
     form for a finger whose EI varies along its length.
     """
+
+
+class Interrupted(KeyboardInterrupt):
+    """The user pressed Ctrl-C (SIGINT): the run stopped without a result.
+
+    A ``KeyboardInterrupt``, so that no ``except Exception`` (a solver's
+    fallback, a report's per-chapter guard) can take it for a failed solve.
+    ``where`` says where the run stopped; ``written`` is true when it
+    stopped only after its result files had been written completely.
+    """
+
+    def __init__(self, where: str, written: bool = False):
+        self.where, self.written = where, written
+        super().__init__(where)

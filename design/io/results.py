@@ -12,6 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
+from design import interrupt
+
 
 def jsonable(value: object) -> object:
     """numpy arrays and scalars to lists and floats; non-finite floats to None."""
@@ -64,6 +66,7 @@ def check_output_folder(out_dir: Path) -> None:
 def write_atomic_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` to ``path`` through a temporary file and a rename, so
     that an interrupted run leaves the old file or none, never half a file."""
+    interrupt.writing()            # from here on, Ctrl-C waits for the run's last file
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:

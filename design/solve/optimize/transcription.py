@@ -32,6 +32,8 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from design.interrupt import checkpoint
+from design.interrupt import requested as interrupt_requested
 from design.physics.bird import BirdDynamics, Loads, belt_motion
 from design.solve.optimize.finger_load import FingerLoad
 from design.solve.optimize.schedule import STAGES, Schedule
@@ -333,6 +335,7 @@ class DesignNLP:
             sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
         wall = time.perf_counter() - t0
         stats = solver.stats()
+        checkpoint(f"in Ipopt, iteration {stats['iter_count']} of an NLP")
         if callback.error is not None:
             raise NLPFailed(f"Ipopt's iteration callback failed: {callback.error!r}") \
                 from callback.error
@@ -404,7 +407,7 @@ def rule_constraints(values: dict, setup, rules: Rules):
 
 class _Progress(ca.Callback):
     """Ipopt iteration callback: records and reports objective and violation;
-    stops Ipopt when the view has stalled."""
+    stops Ipopt when the view has stalled or Ctrl-C was pressed."""
 
     def __init__(self, nlp: DesignNLP, history: list, progress):
         ca.Callback.__init__(self)
@@ -447,7 +450,7 @@ class _Progress(ca.Callback):
             self.error = exc
             return [1]
         # non-zero: Ipopt stops (User_Requested_Stop)
-        return [int(self.stalled())]
+        return [int(self.stalled() or interrupt_requested())]
 
     def _record(self, arg) -> None:
         g = np.asarray(arg[ca.nlpsol_out().index("g")]).ravel()
