@@ -7,11 +7,13 @@ and bird advanced so that nothing touches before), 0.85 s long; the hold is
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 from pathlib import Path
 
-from design.io.grasp_scene import read_grasper
+from design.io.grasp_scene import GraspSettings, read_grasper
+from design.io.scene_writer import grasp_spec
 from design.reproduce.grasp import advanced, load_model, thesis_setup
 from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
 
@@ -28,3 +30,13 @@ def stiffness_space(*groups: str, lo: float = 0.5, hi: float = 1.5) -> DesignSpa
     """Group stiffness scales as the variables (baseline 1)."""
     return DesignSpace(short_setup(), [Variable(f"groups.{g}.stiffness_scale", lo, hi, 1.0)
                                        for g in groups])
+
+
+def short_problem_file(path: Path, variables: dict, **solver) -> Path:
+    """Write a design problem on the short grasp (cap: the baseline's peak,
+    10 ms grid) to ``path`` (JSON is YAML); ``solver``: further settings."""
+    scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
+    path.write_text(json.dumps({"kind": "design", "scene": scene, "cap": "baseline",
+                                "variables": variables,
+                                "solver": {"time_step": 0.01, **solver}}))
+    return path

@@ -9,14 +9,12 @@ import numpy as np
 import pytest
 
 from design.cli import main
-from design.io.grasp_scene import GraspSettings
-from design.io.scene_writer import grasp_spec
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPSettings
 from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, simulate,
                                                 verdict, verify)
-from tests.design_cases import short_setup, stiffness_space
+from tests.design_cases import short_problem_file, stiffness_space
 
 SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
 
@@ -99,13 +97,9 @@ def test_verification_catches_a_design_over_the_cap():
 def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys):
     """End to end through `design solve`: an optimiser that returned a design
     over the cap is reported as failed, loudly, with exit status 1."""
-    setup = short_setup()
-    scene = grasp_spec(setup, GraspSettings(contact_nodes=6), "short", "")
-    problem = {"kind": "design", "scene": scene, "cap": "baseline",
-               "variables": {"groups.lower.stiffness_scale": [0.5, 2.0]},
-               "solver": {"time_step": 0.01, "max_iter": 20, "outer_iterations": 0}}
-    path = tmp_path / "problem.yaml"
-    path.write_text(json.dumps(problem))
+    path = short_problem_file(tmp_path / "problem.yaml",
+                              {"groups.lower.stiffness_scale": [0.5, 2.0]},
+                              max_iter=20, outer_iterations=0)
 
     def over_the_cap(space, cap, settings, rules, start, progress):
         base = simulate(space, space.scale(space.base_values), settings)

@@ -2,7 +2,6 @@
 writes nothing (or every file) and exits 130; CasADi never turns the
 interrupt into a failed solve that changes the answer."""
 
-import json
 import os
 import signal
 import subprocess
@@ -18,6 +17,7 @@ import pytest
 from design.errors import Interrupted
 from design.interrupt import handled, requested, stopped
 from design.io.results import write_atomic
+from tests.design_cases import short_problem_file
 
 ROOT = Path(__file__).resolve().parents[1]
 #: from Ctrl-C to the process's exit (s): the goal is 1 s; the rest is room
@@ -152,16 +152,9 @@ trust_region.simulate_grasp = simulate_grasp
 
 
 def test_ctrl_c_stops_design_solve_in_ipopt_and_claims_nothing(tmp_path):
-    from design.io.grasp_scene import GraspSettings
-    from design.io.scene_writer import grasp_spec
-    from tests.design_cases import short_setup
-
-    scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
-    problem = tmp_path / "problem.yaml"
-    problem.write_text(json.dumps({
-        "kind": "design", "scene": scene, "cap": "baseline",
-        "variables": {"groups.upper.stiffness_scale": [0.5, 1.5]},
-        "solver": {"time_step": 0.01, "max_iter": 200, "outer_iterations": 3}}))
+    problem = short_problem_file(tmp_path / "problem.yaml",
+                                 {"groups.upper.stiffness_scale": [0.5, 1.5]},
+                                 max_iter=200, outer_iterations=3)
     out = tmp_path / "out"
     code, took, stderr = run_and_interrupt(["solve", str(problem), "--out", str(out)],
                                            "ipopt iteration 0:", tmp_path,

@@ -11,12 +11,10 @@ import numpy as np
 import pytest
 
 from design.cli import main
-from design.io.grasp_scene import GraspSettings
-from design.io.scene_writer import grasp_spec
 from design.run.solve import ERROR, FAILED, NO_IMPROVEMENT, VERIFIED, overall_status
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.transcription import DesignNLP, NLPResult
-from tests.design_cases import short_setup
+from tests.design_cases import short_problem_file, short_setup
 
 
 @pytest.fixture(scope="module")
@@ -29,13 +27,9 @@ def problem(tmp_path, one_run, monkeypatch):
     """A design problem on the short grasp whose every simulation is ``one_run``."""
     monkeypatch.setattr("design.solve.optimize.trust_region.simulate_grasp",
                         lambda *args, **kwargs: one_run)
-    scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
-    path = tmp_path / "problem.yaml"
-    path.write_text(json.dumps({
-        "kind": "design", "scene": scene, "cap": "baseline",
-        "variables": {"groups.lower.stiffness_scale": [0.5, 2.0]},
-        "solver": {"time_step": 0.01, "max_iter": 5, "outer_iterations": 2}}))
-    return path
+    return short_problem_file(tmp_path / "problem.yaml",
+                              {"groups.lower.stiffness_scale": [0.5, 2.0]},
+                              max_iter=5, outer_iterations=2)
 
 
 def solve(problem, capsys):
