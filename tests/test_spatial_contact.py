@@ -10,7 +10,7 @@ from design.physics.ellipse import Ellipse
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
 from design.solve.contact import RobustContact
-from design.solve.contact.spatial import Quadric, SpatialContact, sliding_friction
+from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact
 from tests.problems import thesis_finger, uniform_finger
 
 #: semi-axis (m) along the finger frame's z of the ellipsoid built on a planar ellipse
@@ -91,11 +91,10 @@ def test_contact_conditions_hold(name):
 
 
 def test_friction_is_coulomb_on_the_tangent_plane():
-    """With a friction vector t the force on the finger is N (n + t_p), t_p the
-    tangential part of t: its tangential share is |t_p| (µ when sliding)."""
+    """With a given friction vector t the force on the finger is N (n + t_p),
+    t_p the tangential part of t: its tangential share is |t_p|."""
     quadric = ellipsoid_on(ELLIPSES["deep"], 0.3)
-    sliding = np.array([0.3, 0.1, -0.2])
-    t = sliding_friction(0.6, sliding, 0.0)
+    t = np.array([0.3, 0.1, -0.2])
     sol, _ = SpatialContact(thesis_finger()).solve(quadric, t)
     on_finger = -sol.force
     normal_part = on_finger @ sol.normal
@@ -103,6 +102,28 @@ def test_friction_is_coulomb_on_the_tangent_plane():
     t_p = t - (t @ sol.normal) * sol.normal
     assert normal_part > 0
     np.testing.assert_allclose(tangential, normal_part * t_p, atol=1e-9 * normal_part)
+
+
+@pytest.mark.parametrize("speed", [1e-6, 0.05])
+def test_sliding_friction_is_solved_at_the_contact_point(speed):
+    """Under the Coulomb law the tangential force is -µ N w / sqrt(|w|² + ε²),
+    w the tangential sliding velocity a + B r at the solved contact point r
+    itself (1e-9 relative): for ε → 0 its magnitude is µ N, opposite to w."""
+    quadric = ellipsoid_on(ELLIPSES["deep"], 0.3)
+    a = np.array([0.02, -0.01, 0.03])
+    B = np.array([[0.0, -2.1, 0.3], [2.1, 0.0, -0.4], [-0.3, 0.4, 0.0]])   # a rotation's rates
+    law = FrictionLaw(mu=0.6, speed=speed, sliding_at_origin=a, sliding_gradient=B)
+    sol, _ = SpatialContact(thesis_finger()).solve(quadric, law)
+    on_finger = -sol.force
+    normal_part = on_finger @ sol.normal
+    tangential = on_finger - normal_part * sol.normal
+    v = a + B @ sol.point
+    w = v - (v @ sol.normal) * sol.normal
+    expected = -0.6 * normal_part * w / np.sqrt(w @ w + speed ** 2)
+    assert normal_part > 0 and np.linalg.norm(w) > 0.01
+    np.testing.assert_allclose(tangential, expected, atol=1e-9 * normal_part)
+    np.testing.assert_allclose(sol.extras["friction"] * normal_part, expected,
+                               atol=1e-9 * normal_part)
 
 
 def test_continued_and_fresh_solutions_agree():

@@ -15,9 +15,9 @@ never start Newton from a guess that cannot be justified.
    base leaves the model.
 4. Along a sequence of poses (time steps) each continues from the last.
 
-Friction enters as a given vector t (the friction force per unit normal
-force, on the finger); :func:`sliding_friction` turns a sliding velocity
-into it.
+Friction enters as a :class:`FrictionLaw`: a given vector (the friction
+force per unit normal force, on the finger) and/or regularised Coulomb
+friction against the finger's sliding, solved together with the contact.
 """
 
 from __future__ import annotations
@@ -70,9 +70,43 @@ class Quadric:
         return Quadric(np.asarray(p[:3], float), Q)
 
 
+@dataclass(frozen=True)
+class FrictionLaw:
+    """The friction force on the finger per unit normal force at a contact r
+    (finger frame): t0 - µ w / sqrt(|w|² + ε²), w the tangential part of the
+    finger's sliding velocity a + B r over the object (m/s; affine in r for
+    rigid motions of finger and object). Only t's tangential part acts."""
+
+    given: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    mu: float = 0.0
+    #: regularisation speed ε (m/s); any positive value when µ = 0
+    speed: float = 1.0
+    sliding_at_origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    sliding_gradient: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+
+    @property
+    def params(self) -> np.ndarray:
+        """[t0 (3), µ, ε, a (3), B (9, row-major)]: design.solve.contact.spatial_equations."""
+        return np.concatenate([np.asarray(self.given, float), [self.mu, self.speed],
+                               np.asarray(self.sliding_at_origin, float),
+                               np.asarray(self.sliding_gradient, float).ravel()])
+
+    @staticmethod
+    def of(friction: "FrictionLaw | np.ndarray") -> "FrictionLaw":
+        """A law as is, or a given vector (3,) as the law that always gives it."""
+        if isinstance(friction, FrictionLaw):
+            return friction
+        return FrictionLaw(given=np.asarray(friction, float))
+
+
+#: no friction (the parameters the continuation starts from)
+NO_FRICTION = FrictionLaw().params
+
+
 @dataclass
 class SpatialState:
-    """A solved contact: mode, unknowns, and the object and friction they solve."""
+    """A solved contact: mode, unknowns, and the object and friction law
+    parameters (FrictionLaw.params) they solve."""
 
     mode: str
     z: np.ndarray
@@ -202,15 +236,15 @@ class SpatialContact:
         self._last_iterations = 0
 
     # ----------------------------------------------------------------- API
-    def solve(self, quadric: Quadric, friction: np.ndarray = np.zeros(3),
+    def solve(self, quadric: Quadric, friction: FrictionLaw | np.ndarray = NO_FRICTION[:3],
               previous: SpatialState | None = None, detail: bool = True
               ) -> tuple[SpatialSolution, SpatialState | None]:
-        """Contact of the finger with ``quadric`` (finger frame) under the
-        friction vector ``friction`` (3,), continued from ``previous``.
-        Returns the solution and the state to continue from."""
+        """Contact of the finger with ``quadric`` (finger frame) under a
+        friction law or a given friction vector (3,), continued from
+        ``previous``. Returns the solution and the state to continue from."""
         self.newton_iterations = 0
         length = self.finger.length
-        friction = np.asarray(friction, float)
+        friction = FrictionLaw.of(friction).params
         if quadric.level(np.zeros((3, 1)))[0] <= 0.0:
             return no_spatial_contact(length, "the finger base is inside the object: invalid "
                                               "pose", converged=False), None
@@ -220,11 +254,11 @@ class SpatialContact:
         if previous is not None:
             state, msg = self._continue(previous, quadric, previous.friction)
             if state is None and msg != BASE_REACHED:
-                state, msg2 = self._from_grazing(quadric, np.zeros(3))
+                state, msg2 = self._from_grazing(quadric, NO_FRICTION)
                 msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
                       f"first touch" if state is not None else msg2
         else:
-            state, msg = self._from_grazing(quadric, np.zeros(3))
+            state, msg = self._from_grazing(quadric, NO_FRICTION)
         if state is None:
             return no_spatial_contact(length, msg, converged=False), None
         state, held = self._apply_friction(state, friction)
@@ -398,13 +432,6 @@ class SpatialContact:
                                                  f"the object away from the contact") if m)
         return SpatialSolution(True, -force_on_finger, normal_force, point, normal, arc,
                                state.mode == "tip", converged, msg, penetration, pts,
-                               extras={"mode": state.mode, "friction": state.friction.copy(),
+                               extras={"mode": state.mode, "friction": post[16:19].copy(),
                                        "z": state.z.copy(),
                                        "iterations": self.newton_iterations})
-
-
-def sliding_friction(mu: float, sliding: np.ndarray, regularisation: float) -> np.ndarray:
-    """Coulomb friction vector on the finger per unit normal force, -µ v / |v|,
-    regularised below the speed ``regularisation`` (m/s): -µ v / sqrt(|v|² + ε²)."""
-    v = np.asarray(sliding, float)
-    return -mu * v / np.sqrt(v @ v + regularisation ** 2)

@@ -11,15 +11,23 @@ contact point r(L) is
 
     F = N (n + t - (t·n) n),
 
-t a given friction vector (the friction force per unit normal force, e.g.
--µ times the unit sliding direction of the finger over the surface; its
-normal part is dropped). Equations: the rod, G(w; F, L) = 0; the contact
+t the friction force per unit normal force, given by the friction law of
+:class:`FrictionLaw`: a fixed vector t0 plus regularised Coulomb friction
+against the finger's sliding at the contact point itself,
+
+    t = t0 - µ w / sqrt(|w|² + ε²),   w = (I - n nᵀ)(a + B r),
+
+a + B r the rigid finger's velocity over the object's surface at r (m/s,
+affine in r for rigid motions). Solving the law with the contact makes the
+friction a function of the pose and rates alone, not of an earlier
+solution's contact point (its normal part is dropped from t). Equations:
+the rod, G(w; F, L) = 0; the contact
 point on the surface, (r - c)ᵀ Q (r - c) - 1 = 0; and for *interior*
 contact the rod tangent to the surface there, d1 · n = 0. *Tip* contact
 (L = l) drops the tangency.
 
-Parameters q = [l, EI_r, c (3), Q00, Q01, Q02, Q11, Q12, Q22, t (3), h_1..h_K,
-stiffness...].
+Parameters q = [l, EI_r, c (3), Q00, Q01, Q02, Q11, Q12, Q22, friction law
+(17: t0 (3), µ, ε, a (3), B (9, row-major)), h_1..h_K, stiffness...].
 """
 
 from __future__ import annotations
@@ -33,8 +41,8 @@ from design.solve.newton import NewtonCache
 MODES = ("interior", "tip")
 #: index of the quadric (c, Q) in q
 QUADRIC = slice(2, 11)
-#: index of the friction vector t in q
-FRICTION = slice(11, 14)
+#: index of the friction law in q
+FRICTION = slice(11, 28)
 
 
 def quadric_matrix(p):
@@ -46,6 +54,14 @@ def quadric_matrix(p):
 def quadric_params(c: np.ndarray, Q: np.ndarray) -> np.ndarray:
     """[c (3), Q00, Q01, Q02, Q11, Q12, Q22]."""
     return np.concatenate([c, Q[0, :3], Q[1, 1:3], Q[2, 2:3]])
+
+
+def friction_vector(law, r, normal):
+    """t = t0 - µ w / sqrt(|w|² + ε²), w the tangential part of a + B r (CasADi)."""
+    t0, mu, eps, a, B = law[0:3], law[3], law[4], law[5:8], ca.reshape(law[8:17], 3, 3).T
+    v = a + B @ r
+    w = v - ca.dot(v, normal) * normal
+    return t0 - mu * w / ca.sqrt(ca.dot(w, w) + eps ** 2)
 
 
 class SpatialContactTranscription:
@@ -63,12 +79,12 @@ class SpatialContactTranscription:
         self.rod = rod = rod_transcription(stiffness, intervals, degree)
         K, nw = rod.K, rod.n_w
         self.n_z = nw + (2 if mode == "interior" else 1)
-        self.n_q = 14 + K + stiffness.params.size
+        self.n_q = FRICTION.stop + K + stiffness.params.size
         z = ca.SX.sym("z", self.n_z)
         q = ca.SX.sym("q", self.n_q)
         length, ei_r = q[0], q[1]
-        c, Q, t = q[2:5], quadric_matrix(q[5:11]), q[FRICTION]
-        widths, ps = q[14:14 + K], q[14 + K:]
+        c, Q, law = q[2:5], quadric_matrix(q[5:11]), q[FRICTION]
+        widths, ps = q[FRICTION.stop:FRICTION.stop + K], q[FRICTION.stop + K:]
         w, nu = z[:nw], z[nw]
         u = z[nw + 1] if mode == "interior" else 1.0
         L = u * length
@@ -78,6 +94,7 @@ class SpatialContactTranscription:
         r, frame = rod.tip(w, P0)
         grad = Q @ (r - c)
         normal = grad / ca.norm_2(grad)
+        t = friction_vector(law, r, normal)
         t_p = t - ca.dot(t, normal) * normal
         direction = normal + t_p
         P = ca.vertcat(nu * u ** 2 * direction, L, ei_r, widths, ps)
@@ -90,10 +107,10 @@ class SpatialContactTranscription:
         self.residual = ca.Function(f"spatial_{mode}", [z, q], [R], ["z", "q"], ["R"])
         force = nu * ei_r / length ** 2 * direction
         #: (z, q) -> r (3), N, L, level, d1·n, normal (3), force on the finger (3),
-        #: d1 (3); max |R|
+        #: d1 (3), tangential friction per unit normal force t_p (3); max |R|
         self.post = ca.Function(
             f"spatial_{mode}_post", [z, q],
-            [ca.vertcat(r, nu * ei_r / length ** 2, L, level, along, normal, force, d1),
+            [ca.vertcat(r, nu * ei_r / length ** 2, L, level, along, normal, force, d1, t_p),
              ca.mmax(ca.fabs(R))])
         self.shape = ca.Function(f"spatial_{mode}_shape", [z, q], rod.shape(w, P))
         # implicit-function sensitivities: dR/dz, dR/d(c, Q), d(r, L)/dz
@@ -107,12 +124,6 @@ class SpatialContactTranscription:
                    error_on_fail: bool = False) -> ca.Function:
         """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton)."""
         return self._newton.get(tolerance, max_iter, error_on_fail)
-
-    def parameters(self, length: float, ei_ref: float, c: np.ndarray, Q: np.ndarray,
-                   friction: np.ndarray, widths: np.ndarray, stiffness: RodStiffness
-                   ) -> np.ndarray:
-        return np.concatenate([[length, ei_ref], quadric_params(c, Q), friction, widths,
-                               stiffness.params])
 
 
 _CACHE: dict[tuple, SpatialContactTranscription] = {}
