@@ -228,3 +228,35 @@ def test_missing_model_file_names_each_folder_once(tmp_path, capsys, monkeypatch
     err = capsys.readouterr().err
     assert (f"finger file 'models/fingers/none.yaml' not found (looked in {folder} and the "
             f"folders above it, {TOOLKIT_ROOT})\n") in err
+
+
+def test_every_problem_prints_as_one_line(tmp_path, capsys):
+    """Found by tests/test_scene_properties.py: a key with a carriage return,
+    an empty key and a NUL character each used to break a problem over lines."""
+    odd = tmp_path / "odd.yaml"
+    odd.write_text('kind: beam\n"": 1\n"\\r": 2\nfinger: {length: 0.2, EI: 0.08}\n'
+                   'load: {F: 1, at: 0.1, alpha: 1}\nsolver: {method: "fdm\\nx"}\n')
+    nul = tmp_path / "nul.yaml"
+    nul.write_text("kind: beam\x00\n")
+    assert main(["check", str(odd), str(nul)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"error: {odd}: '': unknown key (allowed: finger, load, solver, kind, name, description)",
+        f"error: {odd}: '\\r': unknown key (allowed: finger, load, solver, kind, name, "
+        f"description)",
+        f"error: {odd}: solver.method: 'fdm\\nx' is not one of: small-deflection, frisch-fay, "
+        f"shooting, fdm, collocation; did you mean 'fdm'?",
+        f"error: {nul}: not valid YAML at character 11: special characters are not allowed "
+        f"(code point 0x0)"]
+
+
+def test_design_variables_without_a_scene_are_checked_by_name(tmp_path, capsys):
+    """Found by tests/test_scene_properties.py: without `scene`, an unknown
+    variable name raised KeyError."""
+    path = tmp_path / "problem.yaml"
+    path.write_text('kind: design\nvariables: {"3": null, conveyor.rate: [1 m/s^2, 2 m/s^2]}\n')
+    assert main(["check", str(path)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"error: {path}: scene: required but missing",
+        f"error: {path}: variables.3: no such design variable (allowed: fingers.<name>.<angle|"
+        f"phi_x|phi_y|length|height>, groups.<group>.stiffness_scale, conveyor.<start_time|rate|"
+        f"final_speed>, drum_speed, spacing)"]

@@ -144,13 +144,15 @@ def _variables(reader: Reader, value: object, scene: GraspScene | None):
     out = {}
     for key, bounds in spec.items():
         path = join("variables", str(key))
-        if allowed is not None and key not in allowed:
+        # without a scene (its own problem) only the name's last part can be checked
+        dimension = DIMENSIONS.get(str(key).rsplit(".")[-1])
+        if dimension is None or (allowed is not None and key not in allowed):
             reader.add(path, f"no such design variable (allowed: fingers.<name>.<"
                              f"{'|'.join(FINGER_FIELDS)}>, groups.<group>.stiffness_scale, "
                              f"conveyor.<{'|'.join(CONVEYOR_FIELDS)}>, drum_speed, spacing)"
-                             f"{did_you_mean(key, allowed)}")
+                             f"{did_you_mean(key, allowed or list(DIMENSIONS))}")
             continue
-        values = reader.quantities(spec, key, "variables", DIMENSIONS[str(key).rsplit(".")[-1]])
+        values = reader.quantities(spec, key, "variables", dimension)
         if values is None:
             continue
         if len(values) != 2:

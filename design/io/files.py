@@ -50,6 +50,10 @@ def load_yaml(path: Path, reader: Reader, field: str = "") -> object | None:
         return None
     try:
         return yaml.safe_load(text)
+    except yaml.reader.ReaderError as exc:            # a character YAML does not allow
+        reader.add(field, f"not valid YAML at character {exc.position + 1}: {exc.reason} "
+                          f"(code point {exc.character:#x})")
+        return None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark else ""

@@ -47,7 +47,7 @@ class Reader:
         return not self.problems
 
     def add(self, field: str, message: str) -> None:
-        self.record(Problem(self.file, field, message))
+        self.record(Problem(self.file, one_line(field), one_line(message)))
 
     def record(self, problem: Problem) -> None:
         """Keep ``problem`` once: two checks can find the same one (the
@@ -74,7 +74,7 @@ class Reader:
         allowed = required + optional
         for key in value:
             if key not in allowed:
-                self.add(join(field, str(key)),
+                self.add(join(field, shown(key)),
                          f"unknown key (allowed: {', '.join(allowed)}){did_you_mean(key, allowed)}")
         for key in required:
             if key not in value:
@@ -222,6 +222,19 @@ class Reader:
                            f"{interval(lo, hi, lo_open, hi_open)}{suffix}")
             return None
         return value
+
+
+def one_line(text: str) -> str:
+    """``text`` with unprintable characters (a newline, a carriage return in a
+    key) escaped, so that every problem prints as one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def shown(key: object) -> str:
+    """A key as it appears in a field path: as written, or quoted when it is
+    empty or has surrounding spaces."""
+    text = str(key)
+    return text if text and text.strip() == text else repr(text)
 
 
 def did_you_mean(given: object, allowed: list[str]) -> str:
