@@ -10,6 +10,7 @@ from dataclasses import replace
 from html.parser import HTMLParser
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from design.cli import main
@@ -17,8 +18,11 @@ from design.io.grasp_scene import GraspSettings
 from design.io.scene_writer import grasp_spec, scene_yaml
 from design.report import write_run
 from design.report.design import design_page
+from design.report.grasp_figures import finger_curves
 from design.report.page import write_report
 from design.run import RunOutput
+from design.solve.contact.spatial import Quadric, SpatialContact
+from design.solve.grasp.fingers import FingerState
 from design.solve.grasp.simulation import simulate_grasp
 from tests.design_cases import short_setup
 
@@ -205,3 +209,22 @@ def test_a_report_is_written_whole_or_not_at_all(tmp_path, monkeypatch):
     with pytest.raises(KeyboardInterrupt):
         write_run(tmp_path / "out", output)
     assert not (tmp_path / "out").exists()
+
+
+def test_finger_curves_draw_a_spatial_rod_whole():
+    """A spatial contact's finger is drawn from its rod points: the curve starts
+    at the finger's base and, the rod being inextensible, its polyline is as
+    long as the finger (1 %: the chord error of the collocation points)."""
+    setup = short_setup()
+    gf = setup.grasper.fingers[0]
+    quadric = Quadric(np.array([0.6 * gf.finger.length, 0.045, 0.01]),
+                      np.diag([1 / 0.06 ** 2, 1 / 0.05 ** 2, 1 / 0.05 ** 2]))
+    sol, _ = SpatialContact(gf.finger).solve(quadric)
+    assert sol.contact and sol.converged
+    states = [FingerState(solution=sol)] + [FingerState()] * (len(setup.grasper.fingers) - 1)
+    curves = finger_curves(setup, 0.3, states)
+    base, R = setup.grasper.drum(setup.drum_speed).frame(gf.mount, 0.3)
+    np.testing.assert_allclose(curves[0], base[:, None] + R @ sol.shape_points, atol=1e-15)
+    length = np.sum(np.linalg.norm(np.diff(curves[0], axis=1), axis=0))
+    assert length == pytest.approx(gf.finger.length, rel=0.01)
+    assert curves[1].shape[1] == 2          # no contact: the straight finger's two ends

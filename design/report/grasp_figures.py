@@ -13,6 +13,8 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Circle, Rectangle
 from matplotlib.patches import Ellipse as EllipsePatch
 
+from design.physics.contact import ContactSolution
+from design.solve.contact.spatial import SpatialSolution
 from design.solve.grasp.simulation import GraspRun, GraspSetup
 
 MM = 1e3
@@ -23,18 +25,26 @@ COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e
 
 def finger_curves(setup: GraspSetup, t: float, states=None) -> list[np.ndarray]:
     """World points (3, n) of every right-drum finger at time t: the deflected
-    shape where a contact solution is given, else the straight finger."""
+    shape where a contact solution is given (planar: in the finger's bending
+    plane; spatial: the rod's points in the finger frame), else the straight
+    finger."""
     drum = setup.grasper.drum(setup.drum_speed)
     curves = []
     for i, gf in enumerate(setup.grasper.fingers):
         base, R = drum.frame(gf.mount, t)
         sol = None if states is None else states[i].solution
-        if sol is not None and sol.contact:
-            local = np.vstack([sol.shape_x, sol.shape_y])
-        else:
-            local = np.vstack([np.linspace(0.0, gf.finger.length, 2), np.zeros(2)])
-        curves.append(base[:, None] + R[:, :2] @ local)
+        curves.append(base[:, None] + R @ _finger_points(sol, gf.finger.length))
     return curves
+
+
+def _finger_points(sol, length: float) -> np.ndarray:
+    """The finger's points (3, n) in its frame (m): a contact solution's shape,
+    else the straight finger."""
+    if isinstance(sol, SpatialSolution) and sol.contact and sol.shape_points is not None:
+        return sol.shape_points
+    if isinstance(sol, ContactSolution) and sol.contact:
+        return np.vstack([sol.shape_x, sol.shape_y, np.zeros(len(sol.shape_x))])
+    return np.vstack([np.linspace(0.0, length, 2), np.zeros((2, 2))])
 
 
 def _bird_outline(setup: GraspSetup, y: np.ndarray, plane: str) -> EllipsePatch:
