@@ -18,7 +18,7 @@ from design import __version__
 from design.io.results import csv_text, json_text
 from design.report.page import Page, write_report
 from design.reproduce import beam_rows, contact_rows, grasp_rows
-from design.reproduce.rows import COLUMNS, Section, tally
+from design.reproduce.rows import COLUMNS, Section, tally, tally_by_basis, verdict
 
 HOW_TO_READ = (
     "Each row sets a number or a claim of the thesis beside ours. A numeric row agrees when "
@@ -27,7 +27,10 @@ HOW_TO_READ = (
     "contact solver's ERR = 0.5 mm), where its number is a reading of a plot, or where it "
     "depends on inputs it gives roughly or not at all; each section says which. A claim row (a "
     "trend "
-    "or a bound) agrees when ours bears it out by the criterion in its explanation. SI units: "
+    "or a bound) agrees when ours bears it out by the criterion in its explanation. The "
+    "'basis' column says what ours is compared with: a number the thesis prints, a statement "
+    "it makes, or, where it prints nothing, one of our own references (a closed form, a finer "
+    "method); no tolerance is derived from our own results. SI units: "
     "m, N, s, rad, N m^2 (the thesis's degrees converted). Disagreements are findings, not "
     "failures: their explanations say what we think causes them.")
 
@@ -73,12 +76,12 @@ def build_page(sections: list[Section], failures: list[str], quick: bool,
     rows = [r for s in sections for r in s.rows]
     agree, total = tally(rows)
     page = Page("Thesis reproduction: ours against the thesis's numbers")
-    verdict = f"{agree} of {total} rows agree with the thesis within their stated tolerance"
+    banner = verdict(rows)
     if quick:
-        verdict += " (--quick: grasp figures skipped)"
+        banner += " (--quick: grasp figures skipped)"
     if failures:
-        verdict += f"; {len(failures)} chapter(s) could not be computed"
-    page.banner(verdict, "failed" if failures else "passed" if agree == total else "neutral")
+        banner += f"; {len(failures)} chapter(s) could not be computed"
+    page.banner(banner, "failed" if failures else "passed" if agree == total else "neutral")
     page.section("Summary", "summary")
     page.text(HOW_TO_READ)
     for message in failures:
@@ -115,7 +118,10 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
     page, wall = build_page(sections, failures, args.quick, t0)
     result = {"kind": "reproduction", "toolkit_version": __version__, "wall_time_s": wall,
               "quick": args.quick, "skipped": [grasp_rows.TITLE] if args.quick else [],
-              "failures": failures, "agree": agree, "total": total, "columns": list(COLUMNS),
+              "failures": failures, "agree": agree, "total": total,
+              "by_basis": {b: {"agree": k, "total": n}
+                           for b, (k, n) in tally_by_basis(rows).items()},
+              "columns": list(COLUMNS),
               "rows": [r.as_dict() for r in rows]}
     files = {"reproduction.json": json_text(result),
              "reproduction.csv": csv_text([r.as_dict() for r in rows])}
@@ -123,6 +129,5 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
         progress(f"writing {out}")
     for path in write_report(out, page, files):
         print(path)
-    print(f"{agree} of {total} rows agree with the thesis within their stated tolerance"
-          + (f"; could not compute: {'; '.join(failures)}" if failures else ""))
+    print(verdict(rows) + (f"; could not compute: {'; '.join(failures)}" if failures else ""))
     return EXIT_FAILED if failures else EXIT_OK

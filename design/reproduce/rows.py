@@ -4,7 +4,11 @@ A numeric row agrees when |ours - thesis| <= tolerance (in the row's unit).
 A claim row (the thesis states a trend, a bound or a reading of a plot)
 agrees when ours bears the claim out, by the criterion its explanation
 states. Every tolerance is fixed before the comparison, from the thesis's
-printed digits, its stated accuracy or the spread of what it did not list.
+printed digits or its stated accuracy, never from our own results.
+
+Each row names its ``basis``: a number the thesis prints, a statement it
+makes (a trend, a bound, a reading of a plot), or one of our own references
+standing in where the thesis prints nothing (a closed form, a finer method).
 """
 
 from __future__ import annotations
@@ -13,8 +17,12 @@ import math
 from dataclasses import dataclass, field
 
 #: the columns of reproduction.json / .csv and of the report's tables, in order
-COLUMNS = ("case", "quantity", "unit", "thesis", "ours", "difference", "relative_difference",
-           "tolerance", "agrees", "explanation")
+COLUMNS = ("case", "quantity", "basis", "unit", "thesis", "ours", "difference",
+           "relative_difference", "tolerance", "agrees", "explanation")
+#: what a row compares ours with
+THESIS_NUMBER, THESIS_STATEMENT, OWN_REFERENCE = ("thesis number", "thesis statement",
+                                                  "own reference")
+BASES = (THESIS_NUMBER, THESIS_STATEMENT, OWN_REFERENCE)
 
 
 class CaseFailed(RuntimeError):
@@ -33,6 +41,7 @@ class Row:
     explanation: str = ""
     tolerance: float | None = None
     holds: bool | None = None
+    basis: str = THESIS_NUMBER
 
     @property
     def numeric(self) -> bool:
@@ -59,21 +68,36 @@ class Row:
 
 
 def compare(case: str, quantity: str, unit: str, thesis: float, ours: float, tolerance: float,
-            explanation: str = "") -> Row:
+            explanation: str = "", basis: str = THESIS_NUMBER) -> Row:
     """A numeric row: agrees when |ours - thesis| <= tolerance (``unit``)."""
-    return Row(case, quantity, unit, float(thesis), float(ours), explanation, float(tolerance))
+    return Row(case, quantity, unit, float(thesis), float(ours), explanation, float(tolerance),
+               basis=basis)
 
 
 def claim(case: str, quantity: str, thesis: str, ours: float | str, holds: bool,
-          explanation: str, unit: str = "") -> Row:
+          explanation: str, unit: str = "", basis: str = THESIS_STATEMENT) -> Row:
     """A claim row: the thesis's statement, our number or finding, and whether it holds."""
     return Row(case, quantity, unit, thesis, float(ours) if not isinstance(ours, str) else ours,
-               explanation, holds=bool(holds))
+               explanation, holds=bool(holds), basis=basis)
 
 
 def tally(rows: list[Row]) -> tuple[int, int]:
     """(rows that agree, rows)."""
     return sum(r.agrees for r in rows), len(rows)
+
+
+def tally_by_basis(rows: list[Row]) -> dict[str, tuple[int, int]]:
+    """Per basis present: (rows that agree, rows)."""
+    return {b: tally([r for r in rows if r.basis == b]) for b in BASES
+            if any(r.basis == b for r in rows)}
+
+
+def verdict(rows: list[Row]) -> str:
+    """'k of n rows agree ...', split by basis."""
+    parts = [f"{b}s: {k} of {n}" for b, (k, n) in tally_by_basis(rows).items()]
+    agree, total = tally(rows)
+    return (f"{agree} of {total} rows agree within their stated tolerance "
+            f"({'; '.join(parts)})")
 
 
 @dataclass
