@@ -2,6 +2,7 @@
 accepted range; exit status 2; nothing written (issue 2, item 6)."""
 
 import json
+import warnings
 from pathlib import Path
 
 import pytest
@@ -260,3 +261,18 @@ def test_design_variables_without_a_scene_are_checked_by_name(tmp_path, capsys):
         f"error: {path}: variables.3: no such design variable (allowed: fingers.<name>.<angle|"
         f"phi_x|phi_y|length|height>, groups.<group>.stiffness_scale, conveyor.<start_time|rate|"
         f"final_speed>, drum_speed, spacing)"]
+
+
+def test_an_overflowing_stiffness_profile_is_one_problem(tmp_path, capsys):
+    """Found by tests/test_scene_properties.py: exp(a s) overflowing to inf
+    passed as a warning; it is a problem, said plainly."""
+    finger = {"length": 0.2, "E": 4.8e6, "I": {**EXPONENTIAL, "a": 1e4}}
+    path = write(tmp_path, with_changes(finger=finger))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert main(["check", str(path)]) == 2
+    # exp(1e4 s) passes the largest double (e^709.78) at s = 0.070978 m: the first
+    # point of the check's 0.2 mm grid beyond it is 0.071 m
+    assert capsys.readouterr().err == (
+        f"error: {path}: finger.I: the rigidity from I is not positive and finite at s = "
+        f"0.071 m, inside the finger (length 0.2 m); accepted: > 0 N m^2 on [0, length]\n")

@@ -157,9 +157,10 @@ def _check_positive(reader: Reader, stiffness: Stiffness, length: float, field: 
                     key: str = "I") -> None:
     """A rigidity must stay positive over the whole finger (a fitted profile may not)."""
     s = np.linspace(0.0, length, 1001)
-    ei = stiffness.ei(s)
+    with np.errstate(over="ignore", invalid="ignore"):   # an overflow is reported below
+        ei = stiffness.ei(s)
     if np.any(~np.isfinite(ei)) or np.any(ei <= 0):
         bad = s[np.argmax(~np.isfinite(ei) | (ei <= 0))]
-        reader.add(join(field, key), f"the rigidity from {key} is not positive at s = "
-                                     f"{bad:g} m, inside the finger (length {length:g} m); "
+        reader.add(join(field, key), f"the rigidity from {key} is not positive and finite at "
+                                     f"s = {bad:g} m, inside the finger (length {length:g} m); "
                                      f"accepted: > 0 N m^2 on [0, length]")
