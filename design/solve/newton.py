@@ -1,15 +1,109 @@
-"""CasADi Newton rootfinders on R(z, q) = 0, built once per setting."""
+"""Newton's method, for every nonlinear solve of the toolkit, with a status.
+
+:func:`damped_newton` solves numpy systems (the beam's finite differences
+and shooting, the thesis's Algorithm II, the BDF-4 step); :class:`NewtonCache`
+builds CasADi rootfinders once per setting (the contact equations).
+"""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Callable
+
 import casadi as ca
+import numpy as np
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """The last iterate ``x`` with its residual, and whether it converged
+    (``message`` says why not)."""
+
+    x: np.ndarray
+    residual: np.ndarray
+    converged: bool
+    iterations: int
+    message: str = ""
+
+
+def damped_newton(fun: Callable[[np.ndarray], tuple[np.ndarray, object]], x0: np.ndarray,
+                  tolerance: float, max_iter: int, *,
+                  solve: Callable[[object, np.ndarray], np.ndarray] = np.linalg.solve,
+                  min_damping: float = 1e-4, relative: bool = False,
+                  residual_tolerance: float = 0.0) -> NewtonResult:
+    """Solve r(x) = 0 by Newton's method with a backtracking line search.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(x) -> (r, J)``: the residual (n,) and its Jacobian in the form
+        ``solve`` takes.
+    x0 : ndarray, shape (n,)
+    tolerance : float
+        Converged once the step taken is at most this in max-norm (times
+        max(1, max|x|) if ``relative``), or the residual at most
+        ``residual_tolerance``.
+    max_iter : int
+    solve : callable, optional
+        ``solve(J, b) -> J⁻¹ b`` (dense by default; e.g. a banded solver);
+        a ``LinAlgError`` or ``ValueError`` counts as a singular Jacobian.
+    min_damping : float, optional
+        Each step x + λ Δx, Δx = -J⁻¹ r, halves λ from 1 until |r| decreases
+        (and is finite), or until λ ≤ ``min_damping``, where it is taken
+        anyway; 1 gives the plain (undamped) Newton iteration.
+
+    Returns
+    -------
+    NewtonResult
+        Not converged when the Jacobian is singular, the residual turns
+        non-finite, or ``max_iter`` iterations do not meet the tolerance.
+    """
+    x = np.array(x0, dtype=float)
+    r, jac = fun(x)
+    for it in range(1, max_iter + 1):
+        try:
+            dx = solve(jac, -r)
+        except (np.linalg.LinAlgError, ValueError):
+            return NewtonResult(x, r, False, it, "singular Jacobian")
+        lam, norm0 = 1.0, np.linalg.norm(r)
+        while True:
+            x_try = x + lam * dx
+            r_try, jac_try = fun(x_try)
+            finite = np.all(np.isfinite(r_try))
+            if (finite and np.linalg.norm(r_try) < norm0) or lam <= min_damping:
+                break
+            lam *= 0.5
+        if not finite or not np.all(np.isfinite(x_try)):
+            return NewtonResult(x_try, r_try, False, it, "Newton diverged (non-finite iterate)")
+        x, r, jac = x_try, r_try, jac_try
+        scale = max(1.0, float(np.max(np.abs(x)))) if relative else 1.0
+        if np.max(np.abs(lam * dx)) <= tolerance * scale or \
+                np.max(np.abs(r)) <= residual_tolerance:
+            return NewtonResult(x, r, True, it)
+    return NewtonResult(x, r, False, max_iter,
+                        f"Newton did not converge in {max_iter} iterations")
+
+
+def forward_difference(residual: Callable[[np.ndarray], np.ndarray], relative_step: float = 1e-7
+                       ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """``fun`` for :func:`damped_newton` from a residual alone: its Jacobian by
+    forward differences, column j stepped by ``relative_step`` max(1, |x_j|)."""
+    def fun(x):
+        r = residual(x)
+        jac = np.empty((r.size, x.size))
+        for j in range(x.size):
+            dx = np.zeros_like(x)
+            dx[j] = relative_step * max(1.0, abs(x[j]))
+            jac[:, j] = (residual(x + dx) - r) / dx[j]
+        return r, jac
+    return fun
 
 
 class NewtonCache:
-    """Rootfinders (z0, q) -> z of one residual, by (tolerance, max_iter,
-    error_on_fail): Newton with line search; ``error_on_fail`` raises instead
-    of returning the last iterate (inside an NLP, where Ipopt then shortens
-    its step)."""
+    """CasADi rootfinders (z0, q) -> z of one residual R(z, q) = 0, built once
+    per (tolerance, max_iter, error_on_fail): Newton with line search;
+    ``error_on_fail`` raises instead of returning the last iterate (inside an
+    NLP, where Ipopt then shortens its step)."""
 
     def __init__(self, name: str, residual: ca.Function, linear_solver: str):
         self.name, self.residual, self.linear_solver = name, residual, linear_solver

@@ -7,7 +7,8 @@ Unknowns w_i = α1(u_i) = ψ + α at u_i = i h, h = 1/(N+1), i = 1..N, for
 
 with central differences (second order). The Jacobian is tridiagonal
 (eqs. 2.29-2.30); Newton steps are solved in O(N) with a banded solver and
-damped by a backtracking line search on the residual, seeded by the
+damped by a backtracking line search on the residual
+(:func:`design.solve.newton.damped_newton`), seeded by the
 Frisch-Fay shape of the compliance-equivalent beam. That is what keeps it
 usable at any N: the thesis's undamped Newton from a crude guess is what
 diverged as the mesh was refined.
@@ -20,6 +21,7 @@ from scipy.linalg import solve_banded
 
 from design.physics.beam import BeamSolution, PointLoad, classify_branch
 from design.solve.beam.base import IterativeMethod, resample
+from design.solve.newton import damped_newton
 
 
 class FiniteDifference(IterativeMethod):
@@ -53,10 +55,7 @@ class FiniteDifference(IterativeMethod):
             wf = full(w)
             d1 = (wf[2:] - wf[:-2]) / (2 * h)
             g = wf[:-2] - 2 * wf[1:-1] + wf[2:] + h ** 2 * (ci * d1 + qi * np.sin(w))
-            return g
-
-        def jacobian(w):
-            # banded storage: rows (upper, diagonal, lower)
+            # banded Jacobian: rows (upper, diagonal, lower)
             ab = np.zeros((3, n))
             ab[0, 1:] = 1 + h * ci[:-1] / 2
             ab[1, :] = -2 + h ** 2 * qi * np.cos(w)
@@ -65,32 +64,12 @@ class FiniteDifference(IterativeMethod):
             # with w_{N+1} = (4 w_N - w_{N-1})/3 and α1' = 2 (w_N - w_{N-1}) / (3h)
             ab[1, -1] = -2 / 3 + 2 * h * ci[-1] / 3 + h ** 2 * qi[-1] * np.cos(w[-1])
             ab[2, -2] = 2 / 3 - 2 * h * ci[-1] / 3
-            return ab
+            return g, ab
 
         psi_g, _ = resample(guess, u[1:-1])
-        w = psi_g + alpha
-        r = residual(w)
-        converged, msg, its = False, "", 0
-        for its in range(1, self.max_iter + 1):
-            try:
-                dw = solve_banded((1, 1), jacobian(w), -r)
-            except (np.linalg.LinAlgError, ValueError):
-                msg = "singular FDM Jacobian"
-                break
-            lam, norm0 = 1.0, np.linalg.norm(r)
-            while True:
-                w_try = w + lam * dw
-                r_try = residual(w_try)
-                if np.linalg.norm(r_try) < norm0 or lam < 1e-4:
-                    break
-                lam *= 0.5
-            w, r = w_try, r_try
-            if np.max(np.abs(lam * dw)) <= self.tolerance:
-                converged = True
-                break
-        else:
-            msg = f"Newton did not converge in {self.max_iter} iterations"
-
+        res = damped_newton(residual, psi_g + alpha, self.tolerance, self.max_iter,
+                            solve=lambda ab, b: solve_banded((1, 1), ab, b))
+        w = res.x
         wf = full(w)
         psi = wf - alpha
         dpsi = np.gradient(wf, h, edge_order=2) / L
@@ -100,6 +79,6 @@ class FiniteDifference(IterativeMethod):
         x = L * np.concatenate([[0.0], np.cumsum((cx[1:] + cx[:-1]) * h / 2)])
         y = L * np.concatenate([[0.0], np.cumsum((sy[1:] + sy[:-1]) * h / 2)])
         return BeamSolution(load, self.name, u * L, x, y, psi, ei * dpsi,
-                            error_estimate=np.inf, converged=converged,
-                            branch=classify_branch(alpha, psi), iterations=its, message=msg,
-                            extras={"N": n})
+                            error_estimate=np.inf, converged=res.converged,
+                            branch=classify_branch(alpha, psi), iterations=res.iterations,
+                            message=res.message, extras={"N": n})

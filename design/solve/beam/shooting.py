@@ -21,6 +21,7 @@ import numpy as np
 
 from design.physics.beam import BeamSolution, PointLoad, classify_branch
 from design.solve.beam.base import IterativeMethod, resample
+from design.solve.newton import damped_newton
 
 
 class Shooting(IterativeMethod):
@@ -114,32 +115,9 @@ class Shooting(IterativeMethod):
                         jac[row, col[j + 1][comp]] = -1.0
             return r, jac
 
-        converged, its, msg = False, 0, ""
-        r, jac = residual(z)
-        scale = max(1.0, kappa)
-        for its in range(1, self.max_iter + 1):
-            try:
-                dz = np.linalg.solve(jac, -r)
-            except np.linalg.LinAlgError:
-                msg = "singular shooting Jacobian"
-                break
-            lam, norm0 = 1.0, np.linalg.norm(r)
-            while True:
-                z_try = z + lam * dz
-                r_try, jac_try = residual(z_try)
-                if np.all(np.isfinite(r_try)) and (np.linalg.norm(r_try) < norm0 or lam < 1e-3):
-                    break
-                lam *= 0.5
-            z, r, jac = z_try, r_try, jac_try
-            if np.max(np.abs(lam * dz)) <= self.tolerance * max(1.0, np.max(np.abs(z))) \
-                    or np.max(np.abs(r)) <= 1e-14 * scale:
-                converged = True
-                break
-        else:
-            msg = f"Newton did not converge in {self.max_iter} iterations"
-        if converged and not np.all(np.isfinite(z)):
-            converged, msg = False, "non-finite shooting state"
-
+        res = damped_newton(residual, z, self.tolerance, self.max_iter, min_damping=1e-3,
+                            relative=True, residual_tolerance=1e-14 * max(1.0, kappa))
+        z = res.x
         psi0, mu0 = unpack(z)
         _, _, path = shoot(psi0, mu0, record=True)
         traj = np.stack(path)                         # (per+1, 2, S)
@@ -148,9 +126,9 @@ class Shooting(IterativeMethod):
         u = np.arange(psi.size) * h
         x, y = _integrate_xy(psi, mu * ei_ref / stiff.ei(u * L), h)
         return BeamSolution(load, self.name, u * L, x * L, y * L, psi, mu * ei_ref / L,
-                            error_estimate=np.inf, converged=converged,
-                            branch=classify_branch(alpha, psi), iterations=its, message=msg,
-                            extras={"segments": nseg, "steps": nseg * per})
+                            error_estimate=np.inf, converged=res.converged,
+                            branch=classify_branch(alpha, psi), iterations=res.iterations,
+                            message=res.message, extras={"segments": nseg, "steps": nseg * per})
 
 
 def _integrate_xy(psi: np.ndarray, dpsi: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:

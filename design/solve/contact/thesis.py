@@ -31,6 +31,7 @@ from design.physics.beam import Finger
 from design.physics.contact import (SIDES, ContactSolution, FingerPose, Motion, no_contact,
                                     segment_overlap)
 from design.physics.ellipse import Ellipse, gradient_casadi, level_casadi
+from design.solve.newton import damped_newton
 
 #: Thesis Table 5-2 / Figure 3-4: effective EI (N m^2) of the soft finger
 #: (E = 4.8 MPa) against contact position x_f (m)
@@ -233,24 +234,13 @@ class AlgorithmII(_Mirrored):
         ei0 = float(self.finger.stiffness.compliance_equivalent(arc))
         force = 3 * ei0 * y0 / arc ** 3 / max(np.sin(alpha), 0.1)
         X = np.concatenate([psi[1:] + alpha, [arc, force, x0, y0, alpha]])
-        q = ell.params
-        converged, its, msg = False, 0, ""
-        for its in range(1, self.max_iter + 1):
-            R, J = (np.asarray(v) for v in self._system(X, q))
-            try:
-                dX = np.linalg.solve(J, -R.ravel())
-            except np.linalg.LinAlgError:
-                msg = "singular Newton matrix"
-                break
-            X = X + dX
-            if not np.all(np.isfinite(X)):
-                msg = "Newton diverged (non-finite iterate)"
-                break
-            if np.max(np.abs(dX)) < self.tolerance:
-                converged = True
-                break
-        else:
-            msg = f"no convergence in {self.max_iter} Newton iterations"
+        # the thesis's plain Newton: no damping
+        def system(X):
+            R, J = self._system(X, ell.params)
+            return np.asarray(R).ravel(), np.asarray(J)
+
+        res = damped_newton(system, X, self.tolerance, self.max_iter, min_damping=1.0)
+        X, converged, its, msg = res.x, res.converged, res.iterations, res.message
         w = X[:n + 1]
         L, F, xi, yi, alpha = X[n + 1:]
         spurious = converged and not (0 < L <= length and F >= 0)
