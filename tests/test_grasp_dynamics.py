@@ -105,3 +105,26 @@ def test_legs_pull_a_lifted_bird_back():
     y = np.array([0.0, MEAN.gamma + 0.02, 0.0, 0.0, 0.0, 0.0])
     acc, n, f = dyn.accelerations(y, Loads(), "air", 0.0)
     assert acc[1] == pytest.approx(-G - 30.0 * 0.02 / MEAN.mass)
+
+
+def test_bdf4_run_stops_when_its_newton_fails(monkeypatch):
+    """The thesis's BDF-4: a step whose Newton fails ends the run, not ok,
+    saying when (issue 12, item 5: the run went on from the last iterate).
+    The accelerations are made non-finite past X = -0.35 m, which the bird
+    riding the belt reaches during the step from t = 0.10 s."""
+    grasp = bare()
+    y0 = np.array([-0.4, MEAN.gamma, 0.0, 0.457, 0.0, 0.0])
+    settings = IntegratorSettings(integrator="bdf4", step=0.01)
+    ok = integrate(grasp, y0, 0.1, settings)
+    assert ok.ok and ok.records[-1].t == pytest.approx(0.1)
+    assert ok.records[-1].y[0] < -0.35
+    accelerations = grasp.dyn.accelerations
+
+    def beyond(z, *args):
+        acc, normal, friction = accelerations(z, *args)
+        return (acc if z[0] < -0.35 else np.full_like(acc, np.nan)), normal, friction
+
+    monkeypatch.setattr(grasp.dyn, "accelerations", beyond)
+    run = integrate(grasp, y0, 0.3, settings)
+    assert not run.ok and run.message.startswith("BDF-4 step from t = 0.1000 s failed")
+    assert run.records[-1].t == pytest.approx(0.1)

@@ -26,6 +26,7 @@ from scipy.optimize import brentq
 
 from design.physics.bird import BirdDynamics, Conveyor, Loads
 from design.solve.grasp.fingers import ContactFailed, FingerForces, FingerState
+from design.solve.newton import damped_newton, forward_difference
 
 STEPPERS = {"dop853": DOP853, "rk45": RK45, "radau": Radau}
 INTEGRATORS = ("adaptive", "bdf4")
@@ -114,9 +115,6 @@ class Grasp:
         loads, states = self.fingers.evaluate(t, y, commit=commit)
         _, normal, friction = self.solve_mode(t, y, mode, slip_sign, loads)
         return Record(t, y.copy(), mode, normal, friction, self.belt(t)[0], states)
-
-    def initial_mode(self, y) -> str:
-        return "stick"
 
 
 def integrate(grasp: Grasp, y0: np.ndarray, t_end: float, settings: IntegratorSettings,
@@ -300,6 +298,9 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
 
 
 # ---------------------------------------------------------------------- BDF-4
+#: the implicit step's Newton (forward-difference Jacobian, undamped as in
+#: the thesis): step tolerance on the state (m, rad, m/s, rad/s), iterations
+NEWTON_TOLERANCE, NEWTON_ITERATIONS = 1e-12, 20
 _BDF = {1: ([1.0], 1.0), 2: ([4 / 3, -1 / 3], 2 / 3), 3: ([18 / 11, -9 / 11, 2 / 11], 6 / 11),
         4: ([48 / 25, -36 / 25, 16 / 25, -3 / 25], 12 / 25)}
 
@@ -332,7 +333,14 @@ def _bdf4(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, prog
             acc, _, _ = dyn.accelerations(z, loads, mode, v_dot, sign)
             return z - known - h * beta * np.concatenate([z[3:], acc])
 
-        z = _newton(residual, history[-1])
+        step = damped_newton(forward_difference(residual), history[-1], NEWTON_TOLERANCE,
+                             NEWTON_ITERATIONS, min_damping=1.0)
+        if not step.converged:
+            traj.ok = False
+            traj.message = (f"BDF-4 step from t = {t:.4f} s failed: {step.message} (largest "
+                            f"residual {np.max(np.abs(step.residual)):.3g})")
+            return traj
+        z = step.x
         t += h
         if mode != "air":
             _, normal, _ = dyn.accelerations(z, loads, mode, v_dot, sign)
@@ -354,23 +362,6 @@ def _bdf4(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, prog
         if progress and n % 50 == 0:
             progress(f"grasp (BDF-4): t = {t:.2f} s of {t_end:g} s")
     return traj
-
-
-def _newton(residual, z0, tol=1e-12, max_iter=20):
-    """Newton with a forward-difference Jacobian (6 unknowns)."""
-    z = z0.copy()
-    for _ in range(max_iter):
-        r = residual(z)
-        J = np.empty((z.size, z.size))
-        for j in range(z.size):
-            dz = np.zeros_like(z)
-            dz[j] = 1e-7 * max(1.0, abs(z[j]))
-            J[:, j] = (residual(z + dz) - r) / dz[j]
-        step = np.linalg.solve(J, -r)
-        z = z + step
-        if np.max(np.abs(step)) < tol:
-            break
-    return z
 
 
 __all__ = ["Grasp", "IntegratorSettings", "Trajectory", "integrate", "INTEGRATORS", "Loads"]
