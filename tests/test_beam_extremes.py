@@ -1,11 +1,13 @@
 """Every beam method at the extremes, each with a defined outcome (issue 2, item 5)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
-from design.solve.beam import solve_beam
+from design.solve.beam import METHODS, solve_beam
 from tests.problems import thesis_finger, tip_distance
 
 NUMERICAL = ["shooting", "fdm", "collocation"]
@@ -119,6 +121,23 @@ def test_exactly_axial_load_buckles_past_euler(method):
     assert above.branch == "buckled+" and above.y[-1] > 0.05
     ff = solve_beam(finger, [PointLoad(2.0 * euler, 0.0, 0.2)], "frisch-fay")[0]
     assert tip_distance(above, ff) <= above.error_estimate + ff.error_estimate
+
+
+@pytest.mark.parametrize("method", NUMERICAL)
+def test_axial_load_past_euler_without_a_buckled_shape_is_not_converged(method, monkeypatch):
+    """If Newton finds no buckled shape past the Euler load, the straight
+    state (an unstable equilibrium there) comes back as not converged, with
+    the reason, and the uniform finger's other equilibrium is reported
+    (issue 12, item 5: it used to be marked converged, the only equilibrium)."""
+    cls = METHODS[method]
+    solve = cls._solve
+    monkeypatch.setattr(cls, "_solve", lambda self, load, guess: replace(
+        solve(self, load, guess), converged=False, message="Newton forced to fail"))
+    euler = np.pi ** 2 * 0.08 / (4 * 0.2 ** 2)
+    sol = solve_beam(uniform(), [PointLoad(2.0 * euler, 0.0, 0.2)], method)[0]
+    assert not sol.converged and sol.branch == "straight"
+    assert "no buckled equilibrium" in sol.message and "Newton forced to fail" in sol.message
+    assert sol.multiple_equilibria is True
 
 
 @pytest.mark.parametrize("method", NUMERICAL)

@@ -114,9 +114,11 @@ class IterativeMethod(BeamMethod):
 
         A non-uniform finger buckles no earlier than a uniform one with its
         smallest EI, so below that Euler load the answer is straight; above,
-        Newton starts from that beam's buckled shape and the straight state
-        (unstable once a buckled equilibrium exists) is returned only if no
-        buckled one is found.
+        Newton starts from that beam's buckled shape. If it finds none, the
+        straight state is returned as not converged: it is an equilibrium,
+        but unstable, and not the branch continued from F = 0. (Past the
+        smallest-EI Euler load the finger may still be below its own, where
+        straight is right, but this method cannot tell.)
         """
         ei_min = float(np.min(self.finger.stiffness.ei(np.linspace(0.0, load.at, 201))))
         if load.force * load.at ** 2 / ei_min <= (np.pi / 2) ** 2:
@@ -125,8 +127,12 @@ class IterativeMethod(BeamMethod):
         sol = self._solve(load, seed(self.finger, load, ei=ei_min))
         if sol.converged and sol.branch == "buckled+":
             return sol
-        return straight_solution(load, self.name, self.nodes + 1,
-                                 message="axial compression: no buckled equilibrium found")
+        failed = sol.message or f"Newton converged to the {sol.branch} branch"
+        straight = straight_solution(
+            load, self.name, self.nodes + 1,
+            message=f"axial compression past the smallest-EI Euler load: no buckled equilibrium "
+                    f"found ({failed}); the straight shape returned may be unstable")
+        return replace(straight, converged=False, multiple_equilibria=None)
 
     def _finish(self, sol: BeamSolution) -> BeamSolution:
         """Say whether another equilibrium exists, where that is known (uniform EI)."""
