@@ -51,3 +51,30 @@ def thesis_grasp_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = 
     from design.reproduce.grasp import thesis_setup
 
     return thesis_setup(t_skip, duration, lower, bird_file)
+
+
+def entering_poses(seed: int, count: int, length: float = 0.203, drum_radius: float = 0.0825):
+    """Random finger poses and objects (issue 12, item 6): semi-axes 30-100 mm
+    by 30-80 mm at any orientation, the object clear of the drum (r > r_D
+    everywhere on it), and the straight finger entering it between 20 % and
+    30 % of its length. Returns [(FingerPose, world-frame Ellipse)]."""
+    from design.physics.contact import FingerPose
+    from design.physics.ellipse import Ellipse
+
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < count:
+        pose = FingerPose(drum_radius, rng.uniform(0.0, 2 * np.pi))
+        a, b, theta = rng.uniform(0.03, 0.1), rng.uniform(0.03, 0.08), rng.uniform(0.0, np.pi)
+        half_height = np.hypot(a * np.sin(theta), b * np.cos(theta))
+        cy = rng.uniform(-0.9, 0.9) * half_height
+        # y_f = 0 enters the ellipse centred at (0, cy) where B00 x² - 2 B01 cy x + B11 cy² = 1
+        B = Ellipse(a, b, (0.0, cy), theta).matrix
+        qb, qc = -2 * B[0, 1] * cy, B[1, 1] * cy ** 2 - 1
+        x_in = (-qb - np.sqrt(qb * qb - 4 * B[0, 0] * qc)) / (2 * B[0, 0])
+        cx = rng.uniform(0.2, 0.3) * length - x_in
+        c = pose.to_world(cx, cy)[:, 0]
+        ell = Ellipse(a, b, (float(c[0]), float(c[1])), theta + pose.angle)
+        if np.min(np.hypot(*ell.point(np.linspace(0.0, 2 * np.pi, 721)))) > drum_radius:
+            out.append((pose, ell))
+    return out

@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.optimize import brentq
 
 from design.physics.ellipse import Ellipse, rotation
 
@@ -152,3 +153,60 @@ def grazing(ellipse: Ellipse, length: float, side: int) -> tuple[float, float] |
     x_g = float(np.clip(x_top, lo, hi))     # y_hi is concave in x
     y_top = e.y_range_at(x_g)[1]
     return float(y_top), x_g
+
+
+def turned(ellipse: Ellipse, angle: float) -> Ellipse:
+    """The ellipse turned by ``angle`` (rad, counter-clockwise) about the finger's base."""
+    c = rotation(angle) @ np.asarray(ellipse.center, float)
+    return Ellipse(ellipse.a, ellipse.b, (float(c[0]), float(c[1])), ellipse.theta + angle)
+
+
+def swept_grazing(ellipse: Ellipse, length: float, side: int) -> tuple[float, float] | None:
+    """How far the object must be turned about the finger's base, against the
+    way it deflects the finger, for the straight finger to just touch it, and
+    where: (turn γ in rad, x of the touching point), so that
+    ``turned(ellipse, γ)`` touches the finger at (x, 0).
+
+    The drum's own motion: turning keeps every distance from the base, so
+    the object never passes over the base on its way. The object meets the
+    disc of the finger's reach (r ≤ l) in a convex set, which subtends less
+    than π from a base outside it; for side = +1 (object towards -y_f) γ is
+    minus the largest polar angle of that set, for side = -1 minus the
+    smallest. The touch is where the ray from the base is tangent to the
+    ellipse, or the finger's tip if that tangent point lies beyond reach.
+    None when the base is inside the object or the object is out of reach.
+    """
+    c = np.asarray(ellipse.center, float)
+    q = rotation(-ellipse.theta) @ -c                    # the base in the ellipse's axes
+    A, B = q[0] / ellipse.a, q[1] / ellipse.b
+    rho = np.hypot(A, B)
+    if rho <= 1.0 or segment_overlap(ellipse, length) >= 0.0:
+        return None
+    towards = np.arctan2(c[1], c[0])
+
+    def polar(p):                                        # angle from the base, about `towards`
+        return towards + _wrap(np.arctan2(p[1], p[0]) - towards)
+
+    t_mid, spread = np.arctan2(B, A), np.arccos(1.0 / rho)
+    tangents = ellipse.point(np.array([t_mid - spread, t_mid + spread])).T
+    pick = np.argmax if side > 0 else np.argmin
+    k = int(pick([polar(p) for p in tangents]))
+    r_touch, phi_touch = float(np.hypot(*tangents[k])), float(polar(tangents[k]))
+    if r_touch > length:
+        # the object's edge within reach is where the ray from the base enters
+        # it at r = l: one crossing between the finger (0, which meets the
+        # object within reach) and the tangent direction
+        def entry_beyond_reach(phi):
+            d = np.array([np.cos(phi), np.sin(phi)])
+            M = ellipse.matrix
+            qa, qb, qc = d @ M @ d, -2 * d @ M @ c, c @ M @ c - 1.0
+            r_in = (-qb - np.sqrt(max(qb * qb - 4 * qa * qc, 0.0))) / (2 * qa)
+            return r_in - length
+        phi_touch = float(brentq(entry_beyond_reach, *sorted((0.0, phi_touch)), xtol=1e-15))
+        r_touch = length
+    return -phi_touch, r_touch
+
+
+def _wrap(angle: float) -> float:
+    """``angle`` mapped into [-π, π)."""
+    return float((angle + np.pi) % (2 * np.pi) - np.pi)

@@ -13,7 +13,11 @@ so this solver never starts from a guess it cannot justify:
    exactly (F = 0, straight finger, contact at the grazing point). The
    object is then moved forward to its real place in steps that halve on
    failure and double on success: every step starts inside Newton's
-   convergence region of the continued solution.
+   convergence region of the continued solution. That way can carry the
+   object over the finger's base; if it fails, the object is instead
+   turned about the base until it grazes the finger and turned back (the
+   drum's own motion, which keeps its distance from the base). With
+   ``sliding: auto`` the other side is tried too.
 3. After every step the mode is checked and switched where it no longer
    holds: a contact point that reaches the tip becomes tip contact; a tip
    whose finger turns tangent to the surface becomes interior contact; a
@@ -42,7 +46,7 @@ import numpy as np
 
 from design.physics.beam import Finger, PointLoad, straight_solution
 from design.physics.contact import (SIDES, ContactSolution, FingerPose, Motion, grazing,
-                                    no_contact, segment_overlap)
+                                    no_contact, segment_overlap, swept_grazing, turned)
 from design.physics.ellipse import Ellipse, rotation
 from design.solve.beam.collocation import adapted_widths
 from design.solve.contact.equations import MODES, contact_transcription
@@ -54,6 +58,9 @@ PENETRATION_TOL = 1e-9
 BASE_FRACTION = 0.01
 BASE_REACHED = ("the contact reached the finger's base (within 1% of its length): the object "
                 "presses on the drum, outside the finger model")
+#: the same, met only on the way in from first touch along y_f: says nothing of the pose
+BASE_PASSED = "the contact reached the finger's base on the way (the object passed over it)"
+SIDE_NAMES = {side: name for name, side in SIDES.items()}
 #: sliding speeds below this (m/s) count as sticking
 STICK_SPEED = 1e-7
 #: Newton iterations per solve: a start inside the convergence region needs 3-6
@@ -197,17 +204,26 @@ class RobustContact:
         if segment_overlap(ell, length) >= 0.0:
             return no_contact(pose, length, "the straight finger misses the object"), None
         side = self._side(ell, sliding, kinematics, previous)
+        # an imposed side is kept; with ``auto`` the other side is the fallback
+        sides = (side,) if sliding in SIDES else (side, -side)
         tau_mu = self._initial_tau_mu(sliding, previous, kinematics)
         if previous is not None and previous.side == side:
             state, msg = self._continue(previous, ell, tau_mu)
-            if state is None and msg != BASE_REACHED:
-                # the continued equilibrium ended (a fold): the finger snaps to
-                # another one, found afresh from first touch
-                state, msg2 = self._from_grazing(ell, side, tau_mu)
+            if state is None:
+                # the continued equilibrium ended (a fold, or the way between
+                # the poses crossed the base): the finger snaps to another one,
+                # found afresh from first touch
+                state, msg2 = self._from_first_touch(ell, sides, tau_mu)
                 msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
                       f"first touch" if state is not None else msg2
         else:
-            state, msg = self._from_grazing(ell, side, tau_mu)
+            state, msg = self._from_first_touch(ell, sides, tau_mu)
+        if state is None and sliding in SIDES and msg != BASE_REACHED:
+            other, _ = self._from_first_touch(ell, (-side,), tau_mu)
+            if other is not None:
+                msg = (f"no equilibrium with the finger deflected to {'+-'[side < 0]}y_f "
+                       f"({sliding}) found: {msg}. The object meets the finger from the other "
+                       f"side here: sliding {SIDE_NAMES[-side]} or auto finds that equilibrium")
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
         friction, v_slide = self._friction_label(tau_mu), None
@@ -243,16 +259,59 @@ class RobustContact:
         return self.mu              # refined by _settle_friction once the contact is solved
 
     # ------------------------------------------------------- continuation
-    def _from_grazing(self, ell: Ellipse, side: int, tau_mu: float):
-        """Move the object back until the straight finger grazes it, then forward."""
+    def _from_first_touch(self, ell: Ellipse, sides: tuple[int, ...], tau_mu: float):
+        """An equilibrium continued from first touch, on the first of ``sides``
+        that has one.
+
+        Two ways in, tried in turn on every side: the object moved back along
+        y_f until the straight finger grazes it, then forward (the shortest
+        way, but it can carry the object over the finger's base, where the
+        contact is lost); then the object turned about the base, the drum's
+        own motion, which keeps its distance from the base. Only a contact
+        that reaches the base on the second way means the object lies at the
+        base.
+        """
+        failures = []
+        for way, approach in (("moved in along y_f", self._moved_in),
+                              ("turned in about the base", self._turned_in)):
+            for side in sides:
+                state, msg = approach(ell, side, tau_mu)
+                if state is not None:
+                    return state, ""
+                failures.append((side, way, msg))
+        if all(msg == BASE_REACHED for _, way, msg in failures if way.startswith("turned")):
+            return None, BASE_REACHED
+        return None, "no equilibrium found from first touch: " + "; ".join(
+            f"{SIDE_NAMES[side]}, {way}: {msg}" for side, way, msg in failures)
+
+    def _moved_in(self, ell: Ellipse, side: int, tau_mu: float):
+        """Move the object back along -side y_f until the straight finger grazes
+        it, then forward."""
         graze = grazing(ell, self.finger.length, side)
         if graze is None:
             return None, "the finger cannot reach the object"
         shift, x_g = graze
-        start = ell.shifted(0.0, -side * shift)
-        length = self.finger.length
-        if x_g <= 1e-9 * length:
+        if x_g <= 1e-9 * self.finger.length:
             return None, "the object reaches the finger at its base: no bending contact"
+        state = self._touching(ell.shifted(0.0, -side * shift), x_g, side, tau_mu)
+        state, msg = self._continue(state, ell, tau_mu)
+        return state, BASE_PASSED if msg == BASE_REACHED else msg
+
+    def _turned_in(self, ell: Ellipse, side: int, tau_mu: float):
+        """Turn the object about the finger's base until the straight finger
+        grazes it, then back (:func:`~design.physics.contact.swept_grazing`)."""
+        graze = swept_grazing(ell, self.finger.length, side)
+        if graze is None:
+            return None, "the finger cannot reach the object"
+        angle, x_g = graze
+        if x_g <= BASE_FRACTION * self.finger.length:
+            return None, BASE_REACHED
+        state = self._touching(turned(ell, angle), x_g, side, tau_mu)
+        return self._follow(state, lambda t: (turned(ell, angle * (1.0 - t)), tau_mu))
+
+    def _touching(self, start: Ellipse, x_g: float, side: int, tau_mu: float) -> _State:
+        """The unloaded straight finger touching ``start`` at (x_g, 0)."""
+        length = self.finger.length
         if x_g < length * (1 - 1e-12):
             mode, z_extra = "interior", [x_g / length]
             t_c = np.array([1.0, 0.0])
@@ -266,23 +325,31 @@ class RobustContact:
         e = normal + tau_mu * t_c
         alpha = float(np.arctan2(e[1], -e[0]))
         z = np.concatenate([np.zeros(self.tr[mode].beam.n_w), [0.0, alpha], z_extra])
-        state = _State(mode, z, start, tau_mu, side)
-        return self._continue(state, ell, tau_mu)
+        return _State(mode, z, start, tau_mu, side)
 
     def _continue(self, state: _State, target: Ellipse, tau_mu: float):
-        """Continue ``state`` to the target ellipse and friction, in adaptive steps."""
+        """Continue ``state`` to the target ellipse and friction along a straight
+        line in (cx, cy, θ, a, b, τµ)."""
         src = state.ellipse
         p0 = np.array([src.center[0], src.center[1], src.theta, src.a, src.b, state.tau_mu])
         p1 = np.array([target.center[0], target.center[1],
                        src.theta + _wrap(target.theta - src.theta), target.a, target.b, tau_mu])
+
+        def path(t):
+            p = p0 + t * (p1 - p0)
+            return Ellipse(p[3], p[4], (p[0], p[1]), p[2]), p[5]
+        return self._follow(state, path)
+
+    def _follow(self, state: _State, path: Callable[[float], tuple[Ellipse, float]]):
+        """Continue ``state`` along ``path(t)`` = (ellipse, τµ), t from 0 (the
+        state's) to 1, in steps that halve on failure and double on success."""
+        target = path(1.0)[0]
         t, step = 0.0, 1.0
         for _ in range(self.max_steps):
             if t >= 1.0:
                 return state, ""
             t_new = min(1.0, t + step)
-            p = p0 + t_new * (p1 - p0)
-            ell = Ellipse(p[3], p[4], (p[0], p[1]), p[2])
-            new = self._step(state, ell, p[5])
+            new = self._step(state, *path(t_new))
             if new is None:
                 step /= 2
                 if step < 1e-7:
@@ -378,7 +445,7 @@ class RobustContact:
         if end is None:
             # the equilibrium ends before the friction reaches the bound (a
             # fold): look for the sliding state afresh from first touch
-            end, msg2 = self._from_grazing(state.ellipse, state.side, target)
+            end, msg2 = self._from_first_touch(state.ellipse, (state.side,), target)
             if end is None:
                 return None, "none", f"no equilibrium with friction ratio {target:+g}: {msg}", None
         v_end = self._sliding_velocity(end, kin)
