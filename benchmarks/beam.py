@@ -24,15 +24,17 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from design.io.fingers import read_finger
 from design.io.results import jsonable
 from design.physics.beam import Finger, PointLoad
-from design.physics.stiffness import ExponentialI, UniformEI
+from design.physics.stiffness import UniformEI
+from design.reproduce.grasp import load_model
 from design.solve.beam import METHODS, solve_beam
 from design.tradeoff.beam import RESOLUTIONS, reference, tips
 from design.tradeoff.study import timed
 
 RESULTS = Path(__file__).parent / "results" / "beam.json"
-THESIS = ExponentialI(4.8e6, 7.3e-8, -3.6551e-8, 3.2102e-9, -70.87, -141.73)
+THESIS = load_model(read_finger, "fingers", "thesis_nonuniform_soft.yaml").stiffness
 CASES = {
     "table_2_1": (Finger(0.203, UniformEI(0.08)), PointLoad(15.0, np.pi / 2, 0.1016)),
     "table_2_3": (Finger(0.203, THESIS), PointLoad(15.0, np.pi / 2, 0.0762)),

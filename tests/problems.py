@@ -3,13 +3,19 @@ benchmarks can use them too)."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
-from design.physics.stiffness import ExponentialI, TableI, UniformEI
+from design.physics.stiffness import TableI, UniformEI
+from design.reproduce.grasp import load_model, thesis_setup
 
-THESIS_I = dict(A=7.3e-8, B=-3.6551e-8, C=3.2102e-9, a=-70.87, b=-141.73)
-SOFT_E, HARD_E = 4.8e6, 9.07e6
+#: the thesis finger's I(s) (eq. 2.33) in soft rubber, and the hard rubber's E (Pa)
+THESIS_SOFT = load_model(read_finger, "fingers", "thesis_nonuniform_soft.yaml")
+SOFT_E = THESIS_SOFT.stiffness.E
+HARD_E = load_model(read_finger, "fingers", "thesis_nonuniform_hard.yaml").stiffness.E
 
 
 def uniform_finger(ei: float = 0.08, length: float = 0.203) -> Finger:
@@ -18,13 +24,15 @@ def uniform_finger(ei: float = 0.08, length: float = 0.203) -> Finger:
 
 
 def thesis_finger(E: float = SOFT_E, length: float = 0.203) -> Finger:
-    """Thesis non-uniform finger, eq. (2.33) with C = 3.2102e-9 (Table 2-3)."""
-    return Finger(length, ExponentialI(E, **THESIS_I), "thesis")
+    """Thesis non-uniform finger, eq. (2.33) with C = 3.2102e-9 (Table 2-3), from
+    models/fingers/, in rubber of Young's modulus E (Pa); out of its plane the
+    round section's rigidities (the rod's default)."""
+    return Finger(length, replace(THESIS_SOFT.stiffness, E=E), "thesis")
 
 
 def table_finger(length: float = 0.203) -> Finger:
     """The thesis finger's I(s) sampled at 12 points, linear between them."""
-    stiff = ExponentialI(SOFT_E, **THESIS_I)
+    stiff = THESIS_SOFT.stiffness
     s = np.linspace(0.0, length, 12)
     return Finger(length, TableI(SOFT_E, tuple(s), tuple(stiff.ei(s) / SOFT_E)), "table")
 
@@ -48,8 +56,6 @@ def thesis_grasp_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = 
                        bird_file: str = "mean_1_80kg.yaml"):
     """The mean-bird grasp of Table 5-3 started ``t_skip`` s in (see
     design.reproduce.grasp.thesis_setup)."""
-    from design.reproduce.grasp import thesis_setup
-
     return thesis_setup(t_skip, duration, lower, bird_file)
 
 

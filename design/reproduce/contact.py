@@ -12,14 +12,18 @@ from __future__ import annotations
 
 import numpy as np
 
+from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
 from design.physics.contact import ContactSolution, FingerPose, Motion
 from design.physics.ellipse import Ellipse
-from design.physics.stiffness import ExponentialI, UniformEI
+from design.physics.stiffness import UniformEI
+from design.reproduce.grasp import load_model
 from design.solve.contact import AlgorithmI, AlgorithmII, RobustContact
 from design.solve.effective_ei import effective_ei
 
-SOFT = Finger(0.203, ExponentialI(4.8e6, 7.3e-8, -3.6551e-8, 3.2102e-9, -70.87, -141.73), "soft")
+#: the thesis's soft finger: its I(s) from models/fingers/ (no other rigidity enters the plane)
+SOFT = Finger(0.203, load_model(read_finger, "fingers", "thesis_nonuniform_soft.yaml").stiffness,
+              "soft")
 UNIFORM = Finger(0.203, UniformEI(0.08), "EI=0.08")
 DRUM_RADIUS = 0.0825
 OMEGA = 20 * 2 * np.pi / 60
