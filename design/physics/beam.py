@@ -166,8 +166,3 @@ def classify_branch(alpha: float, psi: np.ndarray, tol: float = 1e-9) -> str:
         return "buckled+" if psi[-1] > 0 else "buckled-"
     direction = np.sign(np.sin(a))
     return "primary" if np.all(direction * psi >= -tol * span) else "secondary"
-
-
-def small_deflection_tip(load: PointLoad, ei: float) -> float:
-    """Transverse load-point deflection of a uniform beam, linear theory (eq. 2.5), m."""
-    return load.force * np.sin(load.alpha) * load.at ** 3 / (3.0 * ei)
