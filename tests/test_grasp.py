@@ -99,3 +99,19 @@ def test_summary_fields(hard):
     assert peak == s["max_finger_force_N"]
     np.testing.assert_allclose(s["centre_rise_m"],
                                max(r.y[1] for r in hard.trajectory.records) - hard.trajectory.records[0].y[1])
+
+
+def test_the_belt_never_pulls_and_rise_and_clearance_are_told_apart(hard):
+    """N >= 0 at every recorded instant (the belt can only push: lift-off is
+    an event located where N reaches 0); the summary's centre rise is the
+    centre's height gain and its belt clearance the lowest point's largest
+    height above the belt, which differ when the bird pitches."""
+    s = hard.summary
+    normals = [r.normal for r in hard.trajectory.records]
+    assert min(normals) >= 0.0 and s["min_normal_force_N"] == min(normals)
+    b = hard.setup.bird
+    # the lowest point of the pitched ellipse (legs free) lies sqrt(η² sin²θ + γ² cos²θ) below the centre
+    gap = [r.y[1] - np.hypot(b.eta * np.sin(r.y[2]), b.gamma * np.cos(r.y[2]))
+           for r in hard.trajectory.records]
+    assert s["belt_clearance_m"] == pytest.approx(max(gap), abs=1e-12)
+    assert s["max_pitch_rad"] > 0.05 and s["belt_clearance_m"] != s["centre_rise_m"]
