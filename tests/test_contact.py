@@ -283,3 +283,65 @@ def test_invalid_pose_is_reported():
     sol = RobustContact(uniform_finger(), 0.6).solve(pose, inside, "push")
     assert not sol.converged and "base is inside" in sol.message
     assert segment_overlap(pose.view(inside), 0.203) < 0
+
+
+def sticking_scene(mu=0.6, **options):
+    """Case 1 in the finger frame, the object moving along -y_f at 5 cm/s
+    and its surface at the contact moving with the finger's material point
+    of the frictionless equilibrium: the sliding speed vanishes at friction
+    ratio 0, so the contact sticks there. Returns (solver, ellipse, kinematics)."""
+    pose, ell_w = CASE1
+    ell, finger = pose.view(ell_w), uniform_finger()
+    solver = RobustContact(finger, mu, **options)
+    _, free = RobustContact(finger, 0.0).solve_frame(ell, "push", None, None)
+    rates = np.array([0.0, -0.05, 0.0, 0.0, 0.0])
+    speed = solver._sliding_velocity(free, lambda p: (rates, np.zeros(2)))
+    t_c = free.post[9:11]                        # the sliding tangent
+    return solver, ell, lambda p: (rates, speed * t_c)
+
+
+def fail_continuation(monkeypatch, solver, when, name="_continue"):
+    """Make the solver's continuation (or search from first touch, ``name``)
+    to a friction ratio τµ fail where ``when(τµ)``."""
+    real = getattr(solver, name)
+    monkeypatch.setattr(solver, name, lambda state, target, tau_mu: (
+        (None, f"{name} forced to fail") if when(tau_mu) else real(state, target, tau_mu)))
+
+
+def test_sticking_contact_is_found_where_the_sliding_stops():
+    """Bisection on the friction ratio stops where the sliding speed is below
+    STICK_SPEED = 1e-7 m/s; the speed changes by ~5 mm/s across the ratio's
+    range 2µ, so the ratio is within ~3e-5 of 0."""
+    solver, ell, kin = sticking_scene()
+    sol, _ = solver.solve_frame(ell, "auto", kin, None)
+    assert sol.converged and sol.friction == "stick", sol.message
+    assert abs(sol.extras["sliding_velocity"]) <= 1e-7
+    assert sol.extras["friction_ratio"] == pytest.approx(0.0, abs=1e-4)
+
+
+@pytest.mark.parametrize("detail", [True, False])
+def test_stick_bisection_stopped_early_is_not_converged(monkeypatch, detail):
+    """No equilibrium at the bisection's midpoints: the stick is not resolved,
+    and the solution (with its shape, or the brief one of trial evaluations)
+    says so instead of reporting a stick (issue 12, item 5)."""
+    solver, ell, kin = sticking_scene()
+    fail_continuation(monkeypatch, solver, lambda tau_mu: abs(tau_mu) < 0.6 * (1 - 1e-9))
+    sol, _ = solver.solve_frame(ell, "auto", kin, None, detail=detail)
+    assert not sol.converged and "sticking contact not resolved" in sol.message
+    assert "_continue forced to fail" in sol.message
+
+
+def test_failed_friction_reversal_is_not_converged(monkeypatch):
+    """With friction kept at the edge of sliding (the grasp's setting), a
+    finger sliding against its friction faster than the reversal speed has
+    the friction reversed; if no equilibrium with the reversed friction is
+    found, the solution is not converged (it used to keep the old friction
+    and report success; issue 12, item 5)."""
+    solver, ell, kin = sticking_scene(reversal_speed=1e-5)
+    sol, _ = solver.solve_frame(ell, "auto", kin, None)
+    assert sol.converged and sol.friction == "baseward", sol.message
+    for name in ("_continue", "_from_first_touch"):
+        fail_continuation(monkeypatch, solver, lambda tau_mu: tau_mu < 0, name)
+    sol, _ = solver.solve_frame(ell, "auto", kin, None)
+    assert not sol.converged and "the friction could not reverse" in sol.message
+    assert sol.friction == "tipward"

@@ -70,7 +70,7 @@ class ContactSolution:
     Positions in m, force in N, angles in rad. ``point``/``psi``/``alpha``
     are in the finger frame; ``shape_*`` cover the whole finger (the loaded
     part, then the straight rest). ``penetration`` is the deepest point of
-    the finger inside the object (m, 0 when none).
+    the finger inside the object (m, 0 when none, nan when not checked).
     """
 
     contact: bool

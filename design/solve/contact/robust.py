@@ -226,14 +226,14 @@ class RobustContact:
                        f"side here: sliding {SIDE_NAMES[-side]} or auto finds that equilibrium")
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
-        friction, v_slide = self._friction_label(tau_mu), None
+        friction, v_slide, settled = self._friction_label(tau_mu), None, True
         if sliding == "auto" and kinematics is not None and self.mu > 0 and settle:
-            state, friction, msg2, v_slide = self._settle_friction(state, kinematics)
+            state, friction, msg2, v_slide, settled = self._settle_friction(state, kinematics)
             msg = "; ".join(m for m in (msg, msg2) if m)
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
-        sol = self._solution(state, pose, friction, msg) if detail else \
-            self._brief(state, pose, friction, msg)
+        sol = self._solution(state, pose, friction, msg, settled) if detail else \
+            self._brief(state, pose, friction, msg, settled)
         sol.extras["sliding_velocity"] = v_slide
         return sol, state
 
@@ -429,29 +429,35 @@ class RobustContact:
         that opposes the sliding, and stops where v vanishes (stick) or at
         the bound (sliding the other way): the friction force is continued,
         never flipped past a sticking state.
+
+        Returns the state, its friction label, a message, the sliding
+        velocity (m/s) and whether the friction was settled; where it was not
+        (no equilibrium with the friction it needs, or a stick the bisection
+        could not pin down) the message says why and the state is the last
+        one reached.
         """
         v = self._sliding_velocity(state, kin)
         if self.reversal_speed is not None:
             if v * state.tau_mu <= self.reversal_speed * self.mu:   # not clearly reversed
-                return state, self._friction_label(state.tau_mu), "", v
-            moved, msg = self._continue(state, state.ellipse, -state.tau_mu)
+                return state, self._friction_label(state.tau_mu), "", v, True
+            moved, msg = self._refriction(state, -state.tau_mu)
             if moved is None:
-                return state, self._friction_label(state.tau_mu), f"friction kept: {msg}", v
-            return moved, self._friction_label(moved.tau_mu), "", v
+                return (state, self._friction_label(state.tau_mu),
+                        f"the friction could not reverse ({msg}): the finger slides at "
+                        f"{v:+.3g} m/s against it", v, False)
+            return moved, self._friction_label(moved.tau_mu), "", v, True
         if self._consistent(state.tau_mu, v):
-            return state, self._friction_label(state.tau_mu), "", v
+            return state, self._friction_label(state.tau_mu), "", v, True
         target = -self.mu if v > 0 else self.mu
-        end, msg = self._continue(state, state.ellipse, target)
+        end, msg = self._refriction(state, target)
         if end is None:
-            # the equilibrium ends before the friction reaches the bound (a
-            # fold): look for the sliding state afresh from first touch
-            end, msg2 = self._from_first_touch(state.ellipse, (state.side,), target)
-            if end is None:
-                return None, "none", f"no equilibrium with friction ratio {target:+g}: {msg}", None
+            return None, "none", f"no equilibrium with friction ratio {target:+g}: {msg}", None, \
+                False
         v_end = self._sliding_velocity(end, kin)
         if v_end * v > 0 or v_end == 0.0:          # still sliding the same way: at the bound
-            return end, self._friction_label(end.tau_mu), "", v_end
+            return end, self._friction_label(end.tau_mu), "", v_end, True
         a, b, v_a = state, end, v                   # v changes sign in between: stick
+        settled, msg = False, "iteration limit"
         for _ in range(60):
             mid, msg = self._continue(a, a.ellipse, 0.5 * (a.tau_mu + b.tau_mu))
             if mid is None:
@@ -462,9 +468,23 @@ class RobustContact:
             else:
                 b = mid
             if abs(v_a) <= STICK_SPEED or abs(b.tau_mu - a.tau_mu) < 1e-12 * self.mu:
+                settled = True
                 break
+        if not settled:
+            return (a, "stick", f"sticking contact not resolved: the friction ratio is between "
+                                f"{a.tau_mu:+.4f} and {b.tau_mu:+.4f} (µ = {self.mu:g}), where "
+                                f"the finger still slides at {v_a:+.3g} m/s ({msg})", v_a, False)
         return (a, "stick", f"sticking contact: friction ratio {a.tau_mu:+.4f} (µ = {self.mu:g})",
-                v_a)
+                v_a, True)
+
+    def _refriction(self, state: _State, tau_mu: float):
+        """``state`` with its friction ratio continued to ``tau_mu``; where that
+        equilibrium ends first (a fold), the one found afresh from first touch."""
+        end, msg = self._continue(state, state.ellipse, tau_mu)
+        if end is not None:
+            return end, ""
+        end, msg2 = self._from_first_touch(state.ellipse, (state.side,), tau_mu)
+        return end, "" if end is not None else f"{msg}; from first touch: {msg2}"
 
     def _consistent(self, tau_mu: float, v: float) -> bool:
         if tau_mu >= self.mu * (1 - 1e-12):
@@ -502,8 +522,10 @@ class RobustContact:
         return "tipward" if tau_mu > 0 else "baseward"
 
     # -------------------------------------------------------------- output
-    def _solution(self, state: _State, pose: FingerPose, friction: str, msg: str
-                  ) -> ContactSolution:
+    def _solution(self, state: _State, pose: FingerPose, friction: str, msg: str,
+                  settled: bool) -> ContactSolution:
+        """The contact with the finger's whole shape; converged when the
+        friction settled and the finger stays out of the object elsewhere."""
         tr = self.tr[state.mode]
         q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
                           self.widths, self.finger.stiffness)
@@ -519,8 +541,8 @@ class RobustContact:
         # the finger must not pass through the object anywhere but at the contact
         depth = -np.min(state.ellipse.distance_outside(x, y))
         penetration = float(max(depth, 0.0)) if depth > PENETRATION_TOL else 0.0
-        converged = penetration == 0.0
-        if not converged:
+        converged = settled and penetration == 0.0
+        if penetration > 0.0:
             msg = "; ".join(m for m in (msg, f"the finger passes {penetration:.3g} m into the "
                                              f"object away from the contact") if m)
         return ContactSolution(
@@ -530,17 +552,18 @@ class RobustContact:
             extras={"residual": float(resid[0]), "friction_ratio": state.tau_mu,
                     "mode": state.mode, "base_moment": float(moment[0]), "z": state.z.copy()})
 
-
-    def _brief(self, state: _State, pose: FingerPose, friction: str, msg: str
+    def _brief(self, state: _State, pose: FingerPose, friction: str, msg: str, settled: bool
                ) -> ContactSolution:
-        """The contact without the finger's shape (for trial evaluations)."""
+        """The contact without the finger's shape (for trial evaluations):
+        penetration not checked (nan); converged when the friction settled."""
         x_l, y_l, psi_l, force, alpha, arc = state.post[:6]
         s = np.array([0.0, arc])
         return ContactSolution(
             True, float(force), float(alpha), float(arc), (float(x_l), float(y_l)),
             float(psi_l), state.mode == "tip", "push" if state.side > 0 else "pull", friction,
-            pose, s, np.array([0.0, x_l]), np.array([0.0, y_l]), True, self.newton_iterations,
-            msg, extras={"friction_ratio": state.tau_mu, "mode": state.mode, "z": state.z.copy()})
+            pose, s, np.array([0.0, x_l]), np.array([0.0, y_l]), settled,
+            self.newton_iterations, msg, float("nan"),
+            extras={"friction_ratio": state.tau_mu, "mode": state.mode, "z": state.z.copy()})
 
 
 def _wrap(angle: float) -> float:
