@@ -97,3 +97,18 @@ def test_base_reached_only_where_the_object_is_at_the_base():
         sol = RobustContact(finger, 0.4).solve(pose, ell, sliding)
         assert not sol.converged and sol.message == BASE_REACHED, sol.message
     assert min(base_distance(p, e) for p, e in POSES) > BASE_FRACTION * finger.length
+
+
+def test_a_sequence_never_continues_into_the_object():
+    """Poses 565-567 of benchmarks/contact_poses.py's seed in sequence: the
+    last continued from the one before passes 12.5 µm into the object away
+    from the contact (a second contact, outside the model); the solver
+    drops it for the equilibrium found afresh, the pose's own when solved
+    alone."""
+    poses = entering_poses(seed=2012, count=568)[565:]
+    solver = RobustContact(FINGER, 0.0)
+    last = solver.solve_pass(*map(list, zip(*poses)), "auto")[-1]
+    alone = solver.solve(*poses[-1], "auto")
+    assert last.converged and last.penetration == 0.0, last.message
+    assert last.force == pytest.approx(alone.force, rel=1e-9)
+    np.testing.assert_allclose(last.point, alone.point, atol=1e-12)

@@ -207,12 +207,14 @@ class RobustContact:
         # an imposed side is kept; with ``auto`` the other side is the fallback
         sides = (side,) if sliding in SIDES else (side, -side)
         tau_mu = self._initial_tau_mu(sliding, previous, kinematics)
-        if previous is not None and previous.side == side:
+        continued = previous is not None and previous.side == side
+        if continued:
             state, msg = self._continue(previous, ell, tau_mu)
             if state is None:
                 # the continued equilibrium ended (a fold, or the way between
                 # the poses crossed the base): the finger snaps to another one,
                 # found afresh from first touch
+                continued = False
                 state, msg2 = self._from_first_touch(ell, sides, tau_mu)
                 msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
                       f"first touch" if state is not None else msg2
@@ -226,12 +228,30 @@ class RobustContact:
                        f"side here: sliding {SIDE_NAMES[-side]} or auto finds that equilibrium")
         if state is None:
             return no_contact(pose, length, msg, converged=False), None
-        friction, v_slide, settled = self._friction_label(tau_mu), None, True
-        if sliding == "auto" and kinematics is not None and self.mu > 0 and settle:
+        settling = sliding == "auto" and kinematics is not None and self.mu > 0 and settle
+        sol, state = self._settled(state, msg, pose, kinematics, settling, detail)
+        if continued and sol.penetration > 0.0:
+            # the continued equilibrium runs into the object elsewhere (a second
+            # contact, outside the model): the one found afresh, if it does not
+            fresh, _ = self._from_first_touch(ell, sides, tau_mu)
+            if fresh is not None:
+                again, fresh = self._settled(
+                    fresh, "the continued equilibrium passed into the object; snapped to the "
+                           "one found from first touch", pose, kinematics, settling, detail)
+                if again.penetration == 0.0:
+                    return again, fresh
+        return sol, state
+
+    def _settled(self, state: _State, msg: str, pose: FingerPose, kinematics, settling: bool,
+                 detail: bool) -> tuple[ContactSolution, _State | None]:
+        """The solution at ``state``, its friction first made consistent with
+        the sliding when ``settling``; with the finger's shape when ``detail``."""
+        friction, v_slide, settled = self._friction_label(state.tau_mu), None, True
+        if settling:
             state, friction, msg2, v_slide, settled = self._settle_friction(state, kinematics)
             msg = "; ".join(m for m in (msg, msg2) if m)
         if state is None:
-            return no_contact(pose, length, msg, converged=False), None
+            return no_contact(pose, self.finger.length, msg, converged=False), None
         sol = self._solution(state, pose, friction, msg, settled) if detail else \
             self._brief(state, pose, friction, msg, settled)
         sol.extras["sliding_velocity"] = v_slide
