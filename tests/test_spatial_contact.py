@@ -147,3 +147,17 @@ def test_no_contact_and_invalid_poses_are_told_apart():
     on_base = ellipsoid_on(Ellipse(0.0991, 0.0673, (0.0, 0.0)))
     sol, _ = solver.solve(on_base)
     assert not sol.converged and "base is inside" in sol.message
+
+
+def test_a_hairline_graze_is_a_touch_without_force():
+    """A straight finger that enters the object by 1 nm over 20 µm (far below
+    the l/200 grid that finds the grazing direction) touches it without
+    force: no contact, and not a failure (a grasp run stopped on it)."""
+    finger = thesis_finger()
+    r = 0.05
+    x_c = finger.length * (100.5 / 200)              # midway between grid points
+    quadric = Quadric(np.array([x_c, 0.0, r - 1e-9]), np.eye(3) / r ** 2)
+    assert quadric.level(np.array([[x_c], [0.0], [0.0]]))[0] < 0
+    sol, state = SpatialContact(finger).solve(quadric)
+    assert sol.converged and not sol.contact and state is None
+    assert np.all(sol.force == 0.0) and "grazes" in sol.message

@@ -34,6 +34,9 @@ from design.solve.beam.rod import RodStiffness
 from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, PENETRATION_TOL
 from design.solve.contact.spatial_equations import MODES, spatial_transcription
 
+#: the straight finger enters the object over less than grazing_shift's grid
+#: resolves (l / 200): a touch without force, not a failure
+GRAZES = "the straight finger only grazes the object"
 #: Newton iterations per solve, and the most a continuation step may take
 MAX_NEWTON_ITERATIONS, MAX_STEP_ITERATIONS = 20, 12
 #: residual (dimensionless) below which a Newton solve counts as converged
@@ -260,7 +263,7 @@ class SpatialContact:
         else:
             state, msg = self._from_grazing(quadric, NO_FRICTION)
         if state is None:
-            return no_spatial_contact(length, msg, converged=False), None
+            return no_spatial_contact(length, msg, converged=msg == GRAZES), None
         state, held = self._apply_friction(state, friction)
         if held < 1.0:
             msg = "; ".join(m for m in (msg, f"sticking: the finger carries {held:.0%} of the "
@@ -320,7 +323,7 @@ class SpatialContact:
     def _from_grazing(self, quadric: Quadric, friction: np.ndarray):
         graze = grazing_shift(quadric, self.finger.length)
         if graze is None:
-            return None, "the finger cannot reach the object"
+            return None, GRAZES
         shift, x_g = graze
         length = self.finger.length
         if x_g <= 1e-9 * length:
