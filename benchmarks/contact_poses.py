@@ -1,0 +1,101 @@
+"""The planar contact solver on random valid poses, against an independent reference.
+
+Poses from tests/problems.py::entering_poses (the object clear of the drum,
+the straight finger entering it at 20-30 % of its length; the thesis's soft
+finger). Each pose is solved with the side imposed (push, then pull; µ = 0
+and 0.4 in turn) and compared with tests/contact_reference.py (least-energy
+finger refined by solve_bvp) on that side; and, at µ = 0 and at 0.4, with
+the side left to the solver, alone and as one sequence of all the poses
+(each continued from the last, unrelated, one).
+
+Writes benchmarks/results/contact_poses.json. Measured with this script on
+the solver before issue 12's item 6 (commit 52d5d8e): 36 of the 2000
+imposed-side solves ended "the contact reached the finger's base ... the
+object presses on the drum" (the object being at least 2 cm from it), and
+the sequences solved 910 (µ = 0) and 999 (µ = 0.4) of the 1000 poses; the
+poses alone, 1000 of 1000. Since: every one, and the imposed-side solves
+agree with the reference to 3.2e-7 m and 1.2e-5 in force.
+
+    python -m benchmarks.contact_poses              # 1000 poses, ~7 minutes
+    python -m benchmarks.contact_poses --count 200  # (from the checkout root: it
+                                                    # uses tests/ as a package)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from design.physics.contact import SIDES
+from design.solve.contact import RobustContact
+from tests.contact_reference import reference
+from tests.problems import entering_poses, thesis_finger
+
+RESULTS = Path(__file__).parent / "results" / "contact_poses.json"
+SEED = 2012
+
+
+def run(count: int) -> dict:
+    finger = thesis_finger()
+    poses = entering_poses(SEED, count)
+    solvers = {mu: RobustContact(finger, mu) for mu in (0.0, 0.4)}
+    failures: Counter = Counter()
+    imposed = {"solves": 0, "converged": 0, "no_equilibrium_on_side": 0,
+               "said_other_side": 0, "bent_past_90_deg": 0, "max_point_error_m": 0.0,
+               "max_force_error_rel": 0.0}
+    solve_time = ref_time = 0.0
+    for i, (pose, ell) in enumerate(poses):
+        mu = (0.0, 0.4)[i % 2]
+        for sliding in ("push", "pull"):
+            t0 = time.perf_counter()
+            sol = solvers[mu].solve(pose, ell, sliding)
+            solve_time += time.perf_counter() - t0
+            t0 = time.perf_counter()
+            ref = reference(finger, pose.view(ell), mu, SIDES[sliding])
+            ref_time += time.perf_counter() - t0
+            imposed["solves"] += 1
+            imposed["converged"] += sol.converged
+            if not sol.converged:
+                failures[sol.message.split(":")[0]] += 1
+            if ref is None:
+                imposed["no_equilibrium_on_side"] += 1
+                imposed["said_other_side"] += "other side" in sol.message
+            elif sol.converged:
+                imposed["bent_past_90_deg"] += abs(sol.psi) > np.pi / 2
+                imposed["max_point_error_m"] = max(imposed["max_point_error_m"], float(
+                    np.hypot(*np.subtract(sol.point, ref.point))))
+                imposed["max_force_error_rel"] = max(imposed["max_force_error_rel"], float(
+                    abs(sol.force - ref.force) / ref.force))
+    auto = {}
+    for mu, solver in solvers.items():
+        alone = [solver.solve(p, e, "auto") for p, e in poses]
+        chained = solver.solve_pass([p for p, _ in poses], [e for _, e in poses], "auto")
+        auto[f"mu={mu:g}"] = {"poses": count,
+                              "alone_converged": sum(s.converged and s.contact for s in alone),
+                              "sequence_converged": sum(s.converged and s.contact
+                                                        for s in chained)}
+    return {"machine": {"python": platform.python_version(), "cores": os.cpu_count()},
+            "seed": SEED, "poses": count, "imposed_side": imposed,
+            "imposed_side_failures_by_message": dict(failures), "auto_side": auto,
+            "time_per_solve_s": solve_time / (2 * count),
+            "reference_time_per_solve_s": ref_time / (2 * count)}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--count", type=int, default=1000)
+    args = parser.parse_args()
+    result = run(args.count)
+    print(json.dumps(result, indent=1))
+    RESULTS.write_text(json.dumps(result, indent=1) + "\n")
+
+
+if __name__ == "__main__":
+    main()
