@@ -112,3 +112,40 @@ def test_finger_3_misses_the_mean_bird_only_with_table_5_3s_metres():
     table's angles) finger 3 cuts through it."""
     assert reached_fingers(-0.075, 0.5) >= {"4"} and "3" not in reached_fingers(-0.075, 0.5)
     assert "3" in reached_fingers(-0.457, 1.5)
+
+
+def test_the_belt_brings_a_riding_bird_by_its_speed_profile():
+    """belt_arrival: x1 - x0 over v on a constant belt; on Figure 5-10's belt
+    (0.457 -> 0.254 m/s at 2 m/s² from X = -0.142 m) the distance integrates
+    v(t) (checked by the trapezoid rule on 1e-5 s steps, to 1e-6 m)."""
+    from design.physics.bird import Conveyor
+    from design.reproduce.grasp import belt_arrival
+
+    assert belt_arrival(Conveyor(0.457), -0.305, -0.075) == pytest.approx(0.23 / 0.457)
+    belt = Conveyor(0.457, 0.254, 2.0, start_position=-0.142)
+    t1 = belt_arrival(belt, -0.305, -0.075)
+    t = np.linspace(0.0, t1, 60001)
+    start = (-0.142 + 0.305) / 0.457
+    v = np.array([belt.velocity(tk, start)[0] for tk in t])
+    travelled = np.sum((v[1:] + v[:-1]) / 2 * np.diff(t))
+    assert travelled == pytest.approx(0.23, abs=0.457 * 1e-6)
+    assert 0.23 / 0.457 < t1 < 0.23 / 0.254
+
+
+def test_upstream_starts_meet_the_fingers_as_the_mean_bird_does():
+    """designed_phase: a football started at Table 5-4's X0 reaches Table
+    5-3's X0 = -0.075 m (riding the belt) just as every finger stands where
+    it stands at the mean bird's start: the same frames, to 1e-12 m."""
+    from design.reproduce.grasp import (MEAN_START, belt_arrival, football_setup,
+                                        mean_bird_setup)
+
+    football, mean = football_setup(), mean_bird_setup("hard")
+    t1 = belt_arrival(football.conveyor, football.start_x, MEAN_START)
+    drum_f, drum_m = (s.grasper.drum(s.drum_speed) for s in (football, mean))
+    for gf_f, gf_m in zip(football.grasper.fingers, mean.grasper.fingers):
+        if gf_f.name.startswith("3"):
+            continue                  # the football runs finger 3 at φx = 60° (Figs 5-16 to 5-18)
+        base_f, R_f = drum_f.frame(gf_f.mount, t1)
+        base_m, R_m = drum_m.frame(gf_m.mount, 0.0)
+        np.testing.assert_allclose(base_f, base_m, atol=1e-12)
+        np.testing.assert_allclose(R_f, R_m, atol=1e-12)

@@ -5,12 +5,13 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from scipy.optimize import brentq
 
 from design.io.files import TOOLKIT_ROOT
 from design.io.fingers import read_finger
 from design.io.grasp_scene import read_bird, read_conveyor, read_grasper
 from design.io.reader import Reader
-from design.physics.bird import Legs
+from design.physics.bird import Conveyor, Legs, belt_motion
 from design.solve.grasp.simulation import GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
@@ -52,6 +53,29 @@ def advanced(grasper, t_skip: float, omega: float = OMEGA):
         for f in grasper.fingers))
 
 
+def belt_arrival(conveyor: Conveyor, x0: float, x1: float) -> float:
+    """Time (s) the belt takes to carry a bird riding it from x0 to x1 (m),
+    slowing where its centre passes the conveyor's start position."""
+    if not conveyor.decelerates or conveyor.start_position is None \
+            or x1 <= conveyor.start_position:
+        return (x1 - x0) / conveyor.speed
+    start = max(conveyor.start_position - x0, 0.0) / conveyor.speed
+    args = (conveyor.speed, conveyor.final_speed, conveyor.rate, start)
+    return brentq(lambda t: belt_motion(t, *args)[2] - (x1 - x0), 0.0,
+                  (x1 - x0) / conveyor.final_speed + 1.0, xtol=1e-12)
+
+
+def designed_phase(setup: GraspSetup) -> GraspSetup:
+    """The setup with the drums turned back so that the belt brings the bird
+    to Table 5-3's X0 = -0.075 m just as every finger reaches its Table 5-1
+    angle: the phase of the thesis's mean-bird run, the grasper's timing as
+    designed. The thesis prints no drum phase for starts further upstream
+    (Tables 5-4, 5-5); read literally (Table 5-1's angles at their own t = 0)
+    the bird arrives between two finger sets."""
+    t1 = belt_arrival(setup.conveyor, setup.start_x, MEAN_START)
+    return replace(setup, grasper=advanced(setup.grasper, -t1, setup.drum_speed))
+
+
 def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard",
                  bird_file: str = "mean_1_80kg.yaml", start: float = MEAN_START,
                  conveyor_file: str = "constant_0457.yaml", friction: float = 0.4,
@@ -81,19 +105,25 @@ def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL) -> Grasp
 
 
 def football_setup(start: float = FOOTBALL_START, friction: float = 1.16,
-                   phi_x3: float = 60.0, model: str = VALIDATION_MODEL) -> GraspSetup:
+                   phi_x3: float = 60.0, model: str = VALIDATION_MODEL,
+                   phased: bool = True) -> GraspSetup:
     """The Table 5-4 football on the Figure 5-10 belt from ``start`` (m): finger
-    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs."""
+    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs; the drums
+    in :func:`designed_phase` unless ``phased`` is false (Table 5-1's angles
+    at t = 0)."""
     s = thesis_setup(0.0, FOOTBALL_DURATION, "hard", "football.yaml", start,
                      "decelerate_figure_5_10.yaml", friction, Legs(0.0, 0.0), model)
-    return with_phi_x(replace(s, conveyor_friction=1.16), "3", phi_x3)
+    s = with_phi_x(replace(s, conveyor_friction=1.16), "3", phi_x3)
+    return designed_phase(s) if phased else s
 
 
 def sizes_setup(bird: str) -> GraspSetup:
     """A Table 5-5 bird from X0 = -0.381 m, µ = 0.4, on the Figure 5-10 belt
-    (the football studies' profiles; Figure 5-19's X axis starts at -0.25 m)."""
-    return thesis_setup(0.0, FOOTBALL_DURATION, "hard", f"{bird}.yaml", SIZES_START,
-                        "decelerate_figure_5_10.yaml", 0.4, Legs(), VALIDATION_MODEL)
+    (the football studies' profiles; Figure 5-19's X axis starts at -0.25 m),
+    the drums in :func:`designed_phase`."""
+    return designed_phase(thesis_setup(0.0, FOOTBALL_DURATION, "hard", f"{bird}.yaml",
+                                       SIZES_START, "decelerate_figure_5_10.yaml", 0.4, Legs(),
+                                       VALIDATION_MODEL))
 
 
 def simulate_all(setups: dict[str, GraspSetup], progress=None,
