@@ -102,10 +102,9 @@ def _guess(finger: Finger, ell: Ellipse, th: np.ndarray):
 
 
 def _solve(finger: Finger, ell: Ellipse, tau_mu: float, u, state, p, tip: bool):
-    """solve_bvp of the contact; returns (sol, tip) or None."""
+    """solve_bvp of the contact (interior, or at the tip), None if it fails."""
     L = finger.length
     ei_r = finger.stiffness.compliance_equivalent(L)
-    q = ell.params
 
     def split(p):
         return (1.0, p[0], p[1]) if tip else (p[0], p[1], p[2])
@@ -119,15 +118,14 @@ def _solve(finger: Finger, ell: Ellipse, tau_mu: float, u, state, p, tip: bool):
     def bc(ya, yb, p):
         _, _, alpha = split(p)
         x, y, psi = yb[0] * L, yb[1] * L, yb[2]
-        e_ = Ellipse(q[3], q[4], (q[0], q[1]), q[2])
-        g = e_.gradient(x, y)
+        g = ell.gradient(x, y)
         n = g / np.hypot(*g)
         t_f = np.array([np.cos(psi), np.sin(psi)])
         along = t_f @ n
         t_c = t_f if not tip else (t_f - along * n) / np.hypot(*(t_f - along * n))
         e = n + tau_mu * t_c
         d = np.array([-np.cos(alpha), np.sin(alpha)])
-        out = [ya[0], ya[1], ya[2], yb[3], float(e_.level(x, y)),
+        out = [ya[0], ya[1], ya[2], yb[3], float(ell.level(x, y)),
                (d[0] * e[1] - d[1] * e[0]) / np.hypot(*e)]
         if not tip:
             out.append(along)
