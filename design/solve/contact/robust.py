@@ -477,10 +477,11 @@ class RobustContact:
         if v_end * v > 0 or v_end == 0.0:          # still sliding the same way: at the bound
             return end, self._friction_label(end.tau_mu), "", v_end, True
         a, b, v_a = state, end, v                   # v changes sign in between: stick
-        settled, msg = False, "iteration limit"
+        settled, why = False, "60 halvings"
         for _ in range(60):
             mid, msg = self._continue(a, a.ellipse, 0.5 * (a.tau_mu + b.tau_mu))
             if mid is None:
+                why = msg
                 break
             v_mid = self._sliding_velocity(mid, kin)
             if v_mid * v_a > 0:
@@ -493,7 +494,7 @@ class RobustContact:
         if not settled:
             return (a, "stick", f"sticking contact not resolved: the friction ratio is between "
                                 f"{a.tau_mu:+.4f} and {b.tau_mu:+.4f} (µ = {self.mu:g}), where "
-                                f"the finger still slides at {v_a:+.3g} m/s ({msg})", v_a, False)
+                                f"the finger still slides at {v_a:+.3g} m/s ({why})", v_a, False)
         return (a, "stick", f"sticking contact: friction ratio {a.tau_mu:+.4f} (µ = {self.mu:g})",
                 v_a, True)
 
