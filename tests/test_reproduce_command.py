@@ -14,8 +14,20 @@ from pathlib import Path
 
 import pytest
 
+from design.physics.contact import SIDES
+from design.physics.ellipse import Ellipse
 from design.report.page import number
+from design.reproduce.contact import CASES, THESIS_PASS, UNIFORM, pass_position, scene
+from design.reproduce.contact_rows import FEM_REL, FORCE_REL, POINT_TOL
 from design.reproduce.rows import BASES, COLUMNS, claim, compare
+from tests.closed_forms import EFFECTIVE_EI_REL, effective_ei, transverse_cantilever
+from tests.contact_reference import reference
+from tests.problems import thesis_finger
+
+#: the independent contact reference's own error (m, and relative on forces;
+#: tests/test_contact_poses.py) plus our solver's mesh error on these smooth
+#: uniform-finger poses (the change from 10 to 20 intervals, below 1e-11 here)
+REFERENCE_ERROR = 1e-7
 
 SECTIONS = ["summary", "beam", "effective-ei", "contact-cases", "contact-pass", "contact-fem",
             "grasp", "run"]
@@ -57,7 +69,11 @@ def test_paths_printed_and_progress_shown(quick):
 
 
 def test_table_2_1_deflection_matches_the_closed_form(result):
-    """Table 2-1: 0.049184 m, every method within its own error (default resolutions)."""
+    """Table 2-1: 0.049184 m, every method within its own error (default
+    resolutions). The row's number is the classical closed form rounded to 6
+    decimals: checked here against tests/closed_forms.py's quadrature."""
+    exact = transverse_cantilever(15.0, 0.1016, 0.08).y
+    assert abs(exact - 0.049184) <= 5e-7
     for method in ["frisch-fay", "collocation", "shooting", "fdm"]:
         r = row(result, "Table 2-1", f"load-point deflection y, {method}")
         assert r["thesis"] == 0.049184 and r["unit"] == "m"
@@ -67,30 +83,53 @@ def test_table_2_1_deflection_matches_the_closed_form(result):
 
 
 def test_chapter_three_findings(result):
-    """Contact points within 1.5 mm of Table 3-5's, forces 5-10% below it (as
-    if its EI were 7% higher); Case 2's printed y is the misprint, not ours;
-    the FEM's 31.8 N peak is reached with friction from the sliding velocity."""
+    """Contact points within the report's 1.5 mm of Table 3-5's; our forces
+    are the independent reference's (tests/contact_reference.py), and the
+    thesis's are all above them by more than the report's 2 %, by one common
+    factor within that 2 % (as if its EI were 7 % higher); Case 2's printed y
+    is the misprint, ours is the reference's and Figure 3-7's -0.079 m; the
+    FEM's 31.797 N peak is reached within 5 % with friction from the sliding
+    velocity (the row's own tolerance is 10 %)."""
     points = [r for r in result["rows"] if r["case"].startswith("Table 3-5")
               and r["quantity"].startswith("contact point")]
-    assert len(points) == 14 and all(abs(r["difference"]) < 1.5e-3 for r in points)
-    forces = [r for r in result["rows"] if r["case"].startswith("Table 3-5")
-              and r["quantity"] == "contact force |F|" and r["ours"] > 0]
-    assert len(forces) == 7
-    assert all(-0.10 < r["relative_difference"] < -0.05 for r in forces)
+    assert len(points) == 14
+    assert all(r["tolerance"] == POINT_TOL and abs(r["difference"]) < POINT_TOL for r in points)
+    ratios = []
+    for phi, (_, _, force, _) in THESIS_PASS.items():
+        r = row(result, f"Table 3-5, φ = {phi}°", "contact force |F|")
+        if phi == 18:                     # beyond the finger: no contact, no force
+            assert r["ours"] == 0.0
+            continue
+        pose, ell = scene(float(phi), (pass_position(phi), 0.184))
+        ref = reference(UNIFORM, pose.view(ell), 0.6041, SIDES["push"])
+        assert r["thesis"] == force and r["ours"] == pytest.approx(ref.force, rel=REFERENCE_ERROR)
+        assert not r["agrees"] and r["ours"] < (1 - FORCE_REL) * force
+        ratios.append(force / r["ours"])
+    assert len(ratios) == 7
+    assert max(ratios) / min(ratios) <= (1 + FORCE_REL) / (1 - FORCE_REL)
     y = row(result, "Table 3-2, Case 2 (Algorithm I)", "contact point y_i (finger frame)")
-    assert y["thesis"] == 0.040 and y["ours"] == pytest.approx(-0.0794, abs=5e-4)
+    center, phi, side = CASES[2]
+    pose, _ = scene(phi, center)
+    ref = reference(UNIFORM, pose.view(Ellipse(0.0991, 0.0673, center)), 0.6, SIDES[side])
+    assert y["thesis"] == 0.040 and y["ours"] == pytest.approx(ref.point[1], abs=REFERENCE_ERROR)
+    assert y["ours"] == pytest.approx(-0.079, abs=POINT_TOL)
     assert not y["agrees"] and "Figure 3-7" in y["explanation"]
     peak = row(result, "Table 3-6, whole pass", "peak contact force (ours in 1° steps)")
-    assert peak["thesis"] == 31.797 and peak["ours"] == pytest.approx(31.8, rel=0.05)
+    assert peak["thesis"] == 31.797 and peak["ours"] == pytest.approx(peak["thesis"], rel=0.05)
+    assert peak["agrees"] and peak["tolerance"] == pytest.approx(FEM_REL * 31.797)
 
 
 def test_table_5_2_effective_ei(result):
-    """Position matching at 15 N reproduces 0.1108 N m^2 at 50.8 mm within 1%;
-    the hard finger is the soft one x 9.07/4.8 (same shape). Every row is
-    judged on the printed digit (5e-5 N m^2), not on a spread of our own."""
+    """Ours is the independent closed-form position match at 15 N, 90°
+    (tests/closed_forms.py); the thesis's 0.1108 N m^2 at 50.8 mm is 1.5e-4
+    above it, outside the printed digit, and the row says so. The hard finger
+    is the soft one x 9.07/4.8 (same shape). Every row is judged on the
+    printed digit (5e-5 N m^2), not on a spread of our own."""
     soft = row(result, "Table 5-2", "effective EI, soft finger, x_f = 50.80 mm")
     hard = row(result, "Table 5-2", "effective EI, hard finger, x_f = 50.80 mm")
-    assert soft["ours"] == pytest.approx(0.1108, rel=0.01)
+    _, position = effective_ei(thesis_finger().stiffness.ei, 15.0, 0.0508)
+    assert soft["ours"] == pytest.approx(position, rel=EFFECTIVE_EI_REL)
+    assert soft["thesis"] == 0.1108 and not soft["agrees"]
     assert hard["ours"] / soft["ours"] == pytest.approx(9.07 / 4.8, rel=1e-6)
     table = [r for r in result["rows"] if r["case"] == "Table 5-2"]
     assert len(table) == 12 and all(r["tolerance"] == 5e-5 for r in table)
