@@ -15,7 +15,7 @@ sweep). Each row says whether every solve converged (solve_bvp: status 0).
 
 Prints a table and writes benchmarks/results/beam.json.
 
-    python benchmarks/beam.py            # full run, ~1 minute
+    python benchmarks/beam.py            # full run, 11.5 minutes on 2 loaded cores
     python benchmarks/beam.py --quick    # fewer repetitions and a 200-load sweep
 """
 
