@@ -1,6 +1,7 @@
 """Grasp scenes and the grasper, bird and conveyor files they reference."""
 
 import csv
+import json
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,36 @@ def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):
     assert not summary["ok"] and "wall-time budget of 0.2 s" in summary["message"]
     t_reached = float(summary["message"].split("at t = ")[1].split(" s")[0])
     assert 0.0 <= t_reached < 0.6
+
+
+def test_a_failed_contact_fails_the_run_and_names_finger_and_time(tmp_path, monkeypatch):
+    """A contact solve that does not converge inside a grasp run ends it: exit
+    1, summary.ok false, the message names the finger and the time, and no
+    force is counted as zero after it (the series stops there)."""
+    from dataclasses import replace as replaced
+
+    from design.io.grasp_scene import GraspSettings
+    from design.io.scene_writer import grasp_spec, scene_yaml
+    from design.solve.contact.robust import RobustContact
+    from tests.design_cases import short_setup
+
+    scene = tmp_path / "short.yaml"
+    scene.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(contact_nodes=6),
+                                           "short", "the short grasp")))
+    solve = RobustContact.solve_frame
+
+    def failing(self, *args, **kwargs):
+        sol, cont = solve(self, *args, **kwargs)
+        if sol.contact:
+            return replaced(sol, converged=False, message="forced failure"), cont
+        return sol, cont
+
+    monkeypatch.setattr(RobustContact, "solve_frame", failing)
+    assert main(["simulate", str(scene), "--out", str(tmp_path / "out"), "--quiet"]) == 1
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    s = result["summary"]
+    assert not s["ok"] and "contact failed at t = " in s["message"]
+    assert "forced failure" in s["message"] and "finger " in s["message"]
+    rows = (tmp_path / "out" / "timeseries.csv").read_text().splitlines()
+    last_t = float(rows[-1].split(",")[0])
+    assert last_t < short_setup().duration
