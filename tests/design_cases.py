@@ -3,18 +3,31 @@ grasper (tests/data/one_set_grasper.yaml: one set of Table 5-1's fingers at
 angles read under the superseded convention, whose hold varies smoothly with
 the design) on a constant belt from X0 = -0.457 m, started 0.6 s in (fingers
 and bird advanced so that nothing touches before), 0.85 s long; the hold is
-0.36-0.67 s."""
+0.36-0.67 s.
+
+Its simulations are most of the test suite's time (5-15 s each), and
+several tests need the very same run, some through ``design simulate`` or
+``design solve``; :func:`sharing_simulations` computes each distinct one
+once per session."""
 
 from __future__ import annotations
 
+import contextlib
+import dataclasses
+import itertools
 import json
 from dataclasses import replace
 
 from pathlib import Path
 
+import numpy as np
+import pytest
+
 from design.io.grasp_scene import GraspSettings, read_grasper
 from design.io.scene_writer import grasp_spec
 from design.reproduce.grasp import advanced, load_model, thesis_setup
+from design.solve.grasp import simulation
+from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
 
 GRASPER = Path(__file__).parent / "data" / "one_set_grasper.yaml"
@@ -40,3 +53,63 @@ def short_problem_file(path: Path, variables: dict, **solver) -> Path:
                                 "variables": variables,
                                 "solver": {"time_step": 0.01, **solver}}))
     return path
+
+
+#: every distinct simulation of the session (see :func:`sharing_simulations`)
+_RUNS: dict[str, simulation.GraspRun] = {}
+
+
+#: labels that no equation reads; a setup read back from a scene file has none
+_LABELS = {("Grasper", "name"), ("Finger", "name")}
+_unique = itertools.count()
+
+
+def _canonical(value):
+    """``value`` as nested tuples of numbers and strings, equal exactly when
+    the simulation's inputs are (unlike a pickle, which also records which
+    parts are one shared object); labels left out (see ``_LABELS``)."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        kind = type(value).__name__
+        return (kind, tuple((f.name, _canonical(getattr(value, f.name)))
+                            for f in dataclasses.fields(value) if (kind, f.name) not in _LABELS))
+    if isinstance(value, (list, tuple)):
+        return tuple(_canonical(v) for v in value)
+    if isinstance(value, dict):
+        return tuple(sorted((repr(k), _canonical(v)) for k, v in value.items()))
+    if isinstance(value, np.ndarray):
+        return ("ndarray", value.dtype.str, value.shape, tuple(value.ravel().tolist()))
+    if value is None or isinstance(value, (bool, int, float, str, np.number)):
+        return (type(value).__name__, repr(value))
+    return ("never shared", next(_unique))          # unknown: computed every time
+
+
+def _inputs(setup, integrator, contact_nodes, reach_filter) -> str:
+    """A simulation's inputs as one string (floats by repr, exact)."""
+    return repr(_canonical((setup, integrator, contact_nodes, reach_filter)))
+
+
+def shared_simulate_grasp(setup, integrator: IntegratorSettings = IntegratorSettings(),
+                          contact_nodes: int = 6, reach_filter: bool = True, progress=None):
+    """:func:`~design.solve.grasp.simulation.simulate_grasp`, run once per
+    distinct input in the session; the run returned carries the caller's
+    setup. Without a wall-time limit the simulation is deterministic, so a
+    repeat would give the same run; its records are shared, so a test must
+    not change them."""
+    if integrator.max_wall_time is not None:        # the run depends on the machine
+        return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress)
+    key = _inputs(setup, integrator, contact_nodes, reach_filter)
+    if key not in _RUNS:
+        _RUNS[key] = simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter,
+                                               progress)
+    return replace(_RUNS[key], setup=setup)
+
+
+@contextlib.contextmanager
+def sharing_simulations():
+    """While open, the design loop (trust_region: its simulations and
+    verifications) and ``design simulate`` of a grasp scene use
+    :func:`shared_simulate_grasp`."""
+    with pytest.MonkeyPatch.context() as patch:
+        for module in ("design.solve.optimize.trust_region", "design.run.grasp"):
+            patch.setattr(f"{module}.simulate_grasp", shared_simulate_grasp)
+        yield

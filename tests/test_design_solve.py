@@ -1,6 +1,11 @@
 """The optimiser on a short grasp: KKT conditions checked by finite
 differences, a one-variable problem against exhaustive search, and the
-verification that must catch a design breaking the cap."""
+verification that must catch a design breaking the cap.
+
+The tests share their simulations (tests/design_cases.py): the baseline's
+loop simulation is computed once for the KKT, cap-continuation and
+exhaustive-search tests, and the verifications of the baseline and of the
+stiff design once for the verification test and ``design solve``'s."""
 
 import json
 from dataclasses import replace
@@ -14,12 +19,18 @@ from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPSettings
 from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, simulate,
                                                 verdict, verify)
-from tests.design_cases import short_problem_file, stiffness_space
+from tests.design_cases import sharing_simulations, short_problem_file, stiffness_space
 
 SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
 
 
-def test_kkt_conditions_hold_by_finite_differences():
+@pytest.fixture
+def shared_simulations():
+    with sharing_simulations():
+        yield
+
+
+def test_kkt_conditions_hold_by_finite_differences(shared_simulations):
     """Stationarity of the Lagrangian (Ipopt's multipliers, derivatives by
     central differences of the constraint functions, independent of CasADi's
     AD) and complementarity of every inequality, at a converged optimum with
@@ -65,7 +76,7 @@ def test_kkt_conditions_hold_by_finite_differences():
     assert np.all(lam_g[inequality & (upper_gap > 1e-4)] <= 1e-6)
 
 
-def test_one_variable_optimum_matches_exhaustive_search():
+def test_one_variable_optimum_matches_exhaustive_search(shared_simulations):
     """Upper-finger stiffness alone: the simulated hold over a 0.025 grid of
     the scale peaks near 0.88 (0.3165 s at 0.9 against 0.3085 s for the
     baseline); the optimiser, from the baseline, must do at least as well as
@@ -81,9 +92,11 @@ def test_one_variable_optimum_matches_exhaustive_search():
     assert abs(scale - (0.5 + grid[best])) <= 0.05
 
 
-def test_verification_catches_a_design_over_the_cap():
+def test_verification_catches_a_design_over_the_cap(shared_simulations):
     """Stiffer lower fingers press harder: judged against the baseline's own
-    peak as the cap, the verification fails it; the baseline itself passes."""
+    peak as the cap, the verification fails it; the baseline itself passes.
+    (The next test's ``design solve`` verifies the same two designs with the
+    same settings, so these runs serve both.)"""
     space = stiffness_space("lower", hi=2.0)
     baseline = verify(space, space.scale(space.base_values), SETTINGS)
     stiff = verify(space, [1.0], SETTINGS)                       # scale 2
@@ -94,7 +107,8 @@ def test_verification_catches_a_design_over_the_cap():
     assert not verdict(baseline.hold * 1.03, baseline, baseline.peak)["passed"]   # 3% off
 
 
-def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys):
+def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys,
+                                                   shared_simulations):
     """End to end through `design solve`: an optimiser that returned a design
     over the cap is reported as failed, loudly, with exit status 1."""
     path = short_problem_file(tmp_path / "problem.yaml",
@@ -121,7 +135,7 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
         body.index("<h2")
 
 
-def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch):
+def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch, shared_simulations):
     """Continuation in the cap: the NLP of outer iteration k sees the cap
     times 1 - margin / 2^k (here every NLP fails, so the loop only records
     the caps it asked for while its trust region shrinks to nothing)."""

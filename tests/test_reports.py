@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import base64
 import json
-from dataclasses import replace
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -23,8 +22,8 @@ from design.report.page import write_report
 from design.run import RunOutput
 from design.solve.contact.spatial import Quadric, SpatialContact
 from design.solve.grasp.fingers import FingerState
-from design.solve.grasp.simulation import simulate_grasp
-from tests.design_cases import short_setup
+from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -126,15 +125,19 @@ GRASP_FIGURES = ["fig-layout", "fig-path", "fig-normal_force", "fig-finger_force
 
 
 def short_scene(tmp_path) -> Path:
+    """The short grasp as a scene file integrated as the design loop does
+    (LOOP_SIMULATOR), so that its simulation is also the design run's and
+    the optimiser tests' baseline: one run for all (tests/design_cases.py)."""
     path = tmp_path / "short.yaml"
-    path.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(contact_nodes=6),
+    path.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(LOOP_SIMULATOR, 6),
                                           "short", "the short grasp")))
     return path
 
 
 def test_grasp_report(tmp_path):
-    assert main(["simulate", str(short_scene(tmp_path)), "--out", str(tmp_path / "out"),
-                 "--quiet"]) == 0
+    with sharing_simulations():
+        assert main(["simulate", str(short_scene(tmp_path)), "--out", str(tmp_path / "out"),
+                     "--quiet"]) == 0
     out = tmp_path / "out"
     r, result = read(out), json.loads((out / "result.json").read_text())
     assert r.sections == ["scene", "summary", *GRASP_SECTIONS, "reproduce"]
@@ -148,7 +151,8 @@ def test_grasp_report(tmp_path):
 
 @pytest.fixture(scope="module")
 def design_run(tmp_path_factory):
-    """One short design solve (one outer iteration) written with its report."""
+    """One short design solve (one outer iteration) written with its report;
+    its simulations shared with the other tests' (tests/design_cases.py)."""
     tmp = tmp_path_factory.mktemp("design")
     problem = {"kind": "design", "name": "short_design", "description": "A short test.",
                "scene": str(short_scene(tmp)), "cap": "baseline",
@@ -156,7 +160,8 @@ def design_run(tmp_path_factory):
                "solver": {"time_step": 0.01, "max_iter": 15, "outer_iterations": 1}}
     path = tmp / "problem.yaml"
     path.write_text(json.dumps(problem))
-    status = main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
+    with sharing_simulations():
+        status = main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
     return status, tmp / "out"
 
 
@@ -184,13 +189,14 @@ def test_design_report_has_every_section_and_matches_result(design_run):
 
 def test_design_report_draws_the_pareto_curve(design_run, tmp_path):
     """With a Pareto study the report adds its table and curve (the study's
-    rows here are made up; the page only draws them)."""
+    rows here are made up; the page only draws them; the runs drawn are the
+    short grasp's, the design run's own baseline)."""
     _, out = design_run
     result = json.loads((out / "result.json").read_text())
     result["pareto"] = [{"cap_N": c, "status": "verified", "optimiser_hold_time_s": h,
                          "verified_hold_time_s": h, "verified_max_finger_force_N": c - 1,
                          "passed": True} for c, h in [(10.0, 0.1), (12.0, 0.2)]]
-    run = simulate_grasp(replace(short_setup(), duration=0.3))
+    run = shared_simulate_grasp(short_setup(), LOOP_SIMULATOR)
     write_report(tmp_path, design_page(result, run, run))
     r = read(tmp_path)
     assert "pareto" in r.sections and "fig-pareto" in r.figures
