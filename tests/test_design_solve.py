@@ -76,17 +76,27 @@ def test_kkt_conditions_hold_by_finite_differences(shared_simulations):
     assert np.all(lam_g[inequality & (upper_gap > 1e-4)] <= 1e-6)
 
 
+@pytest.mark.slow
 def test_one_variable_optimum_matches_exhaustive_search(shared_simulations):
     """Upper-finger stiffness alone: the simulated hold over a 0.025 grid of
     the scale peaks near 0.88 (0.3165 s at 0.9 against 0.3085 s for the
     baseline); the optimiser, from the baseline, must do at least as well as
-    the grid to within 1 ms."""
+    the grid to within 1 ms.
+
+    Slow (nine simulations and three outer iterations: 174 s at load 2-3 on
+    2 cores), so run by ``pytest -m slow`` only; the same loop with a real
+    NLP, its simulation and fixed-design view runs in every suite through
+    test_reports.py's design solve. 40 Ipopt iterations per NLP, as
+    problems/hold_time.yaml allows: the first NLP reaches its final hold by
+    iteration 8 and only dithers after (150 took 64 s and gave the same
+    design within 0.01)."""
     space = stiffness_space("upper")
     grid = np.linspace(0.3, 0.5, 9)                 # scales 0.80 ... 1.00
     holds = [simulate(space, [d], SETTINGS).hold for d in grid]
     best = int(np.argmax(holds))
     assert 0 < best < grid.size - 1                 # an interior optimum
-    out = optimise(space, 100.0, LoopSettings(nlp=SETTINGS.nlp, outer_iterations=3))
+    out = optimise(space, 100.0, LoopSettings(nlp=replace(SETTINGS.nlp, max_iter=40),
+                                              outer_iterations=3))
     scale = space.design(out.best.d)["groups.upper.stiffness_scale"]
     assert out.best.hold >= max(holds) - 1e-3
     assert abs(scale - (0.5 + grid[best])) <= 0.05
