@@ -211,6 +211,18 @@ def _motion(run: GraspRun) -> str:
             f"{np.degrees(s['max_pitch_rad']):.0f}°, peak {_peak(run)}")
 
 
+def pushed_back(runs: dict[str, GraspRun], case: str, what: str, named: dict[str, str]) -> Row:
+    """The thesis's 'pushed back at the first setting, passes at the others'
+    (Figures 5-17, 5-18) against the runs ``named`` {setting label: run name}."""
+    (first, head), *rest = named.items()
+    others = " and ".join(label for label, _ in rest)
+    statement = f"pushed back at {first}; passes at {others}"
+    return claim(case, f"{what}: {statement}", statement,
+                 "; ".join(f"{label}: {_motion(runs[n])}" for label, n in named.items()),
+                 not passes(runs[head]) and all(passes(runs[n]) for _, n in rest),
+                 f"Criterion: {first} does not pass, {others} do.")
+
+
 def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
     run = runs[FOOTBALL]
     fb = run.summary
@@ -247,18 +259,12 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         "φx = 60°)", "both pass", f"-0.381 m: {_motion(runs[far[1.16]])}; -0.305 m: "
         f"{_motion(run)}", passes(runs[far[1.16]]) and passes(run),
         "Criterion: both pass (as above).")]
-    friction = lambda: [claim(  # noqa: E731
-        "Figure 5-17, football from X0 = -0.381 m", "friction: pushed back at µ = 0, passes at "
-        "0.4 and 1.16", "pushed back at µ = 0; passes at 0.4 and 1.16",
-        "; ".join(f"µ = {m:g}: {_motion(runs[n])}" for m, n in far.items()),
-        not passes(runs[far[0.0]]) and passes(runs[far[0.4]]) and passes(runs[far[1.16]]),
-        "Criterion: µ = 0 does not pass, 0.4 and 1.16 do.")]
-    mount = lambda: [claim(  # noqa: E731
-        "Figure 5-18, football from X0 = -0.381 m", "finger 3's φx: pushed back at 45°, passes "
-        "at 60° and 70°", "pushed back at 45°, passes at 60° and 70°",
-        "; ".join(f"φx = {d:g}°: {_motion(runs[n])}" for d, n in phi.items()),
-        not passes(runs[phi[45.0]]) and passes(runs[phi[60.0]]) and passes(runs[phi[70.0]]),
-        "Criterion: 45° does not pass, 60° and 70° do.")]
+    friction = lambda: [pushed_back(  # noqa: E731
+        runs, "Figure 5-17, football from X0 = -0.381 m", "friction",
+        {f"µ = {m:g}": n for m, n in far.items()})]
+    mount = lambda: [pushed_back(  # noqa: E731
+        runs, "Figure 5-18, football from X0 = -0.381 m", "finger 3's φx",
+        {f"{d:g}°": n for d, n in phi.items()})]
     return (unfinished(experiment, runs, [FOOTBALL], case, "the experiment (rise, pitch, "
                        "passing, peak finger and force)", "rise 18 mm, passes, finger 4 about "
                        "8.5 N")

@@ -1,0 +1,31 @@
+"""Chapter V claim rows judged on stand-in runs (no simulation)."""
+
+from types import SimpleNamespace
+
+import numpy as np
+
+from design.reproduce.grasp_rows import BACK_OFF, pushed_back
+
+
+def run(xs):
+    """A run whose centre X goes through ``xs`` (m)."""
+    records = [SimpleNamespace(y=np.array([x, 0.07, 0.0])) for x in xs]
+    return SimpleNamespace(trajectory=SimpleNamespace(records=records),
+                           setup=SimpleNamespace(duration=1.6),
+                           summary={"centre_rise_m": 0.01, "max_pitch_rad": 0.1,
+                                    "max_finger_force_N": 9.0, "max_finger_force_finger": "4a"})
+
+
+def test_pushed_back_holds_only_when_the_first_fails_and_the_others_pass():
+    """Figures 5-17 and 5-18: the first setting pushed back (more than
+    BACK_OFF behind its furthest X), every other past the drum axis."""
+    back = run([-0.3, -0.1, -0.1 - 2 * BACK_OFF])
+    through = run([-0.3, 0.0, 0.2])
+    named = {"µ = 0": "back", "µ = 0.4": "through", "µ = 1.16": "also"}
+    row = pushed_back({"back": back, "through": through, "also": through}, "Fig", "friction",
+                      named)
+    assert row.agrees and row.thesis == "pushed back at µ = 0; passes at µ = 0.4 and µ = 1.16"
+    assert not pushed_back({"back": through, "through": through, "also": through}, "Fig",
+                           "friction", named).agrees
+    assert not pushed_back({"back": back, "through": through, "also": back}, "Fig",
+                           "friction", named).agrees
