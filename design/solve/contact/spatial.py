@@ -239,7 +239,7 @@ class SpatialContact:
         self._last_iterations = 0
 
     # ----------------------------------------------------------------- API
-    def solve(self, quadric: Quadric, friction: FrictionLaw | np.ndarray = NO_FRICTION[:3],
+    def solve(self, quadric: Quadric, friction: FrictionLaw | np.ndarray = FrictionLaw(),
               previous: SpatialState | None = None, detail: bool = True
               ) -> tuple[SpatialSolution, SpatialState | None]:
         """Contact of the finger with ``quadric`` (finger frame) under a
@@ -299,12 +299,13 @@ class SpatialContact:
 
     def _apply_friction(self, state: SpatialState, friction: np.ndarray
                         ) -> tuple[SpatialState, float]:
-        """Continue ``state`` from its friction vector to ``friction``; where the
-        equilibrium ends before (a fold: the sliding friction would drag the
-        contact off), stop at the last equilibrium. Its friction is a convex
-        combination of two vectors inside the Coulomb cone, so it is inside
-        too: the contact sticks there. Returns the state and the fraction of
-        the change carried."""
+        """Continue ``state`` from its friction law parameters to ``friction``
+        (FrictionLaw.params); where the equilibrium ends before (a fold: the
+        sliding friction would drag the contact off), stop at the last
+        equilibrium. Its law's parameters interpolate the two laws', so for
+        Coulomb laws its friction stays below the larger µ: inside the cone,
+        the contact sticks there. Returns the state and the fraction of the
+        change carried."""
         if np.array_equal(state.friction, friction):
             return state, 1.0
         start = state.friction
