@@ -103,3 +103,21 @@ def test_support_derivatives():
         Dp, Dm = dyn.support(theta + h)[1], dyn.support(theta - h)[1]
         assert d1 == pytest.approx((Dp - Dm) / (2 * h), rel=1e-7)
         assert d2 == pytest.approx((Dp - 2 * D + Dm) / h ** 2, rel=1e-4)
+
+
+@pytest.mark.parametrize("tilt", [0.0, 0.3])
+def test_a_point_carried_by_the_drum_follows_its_finger_frames(tilt):
+    """The reach filter turns a finger's base and axis at t = 0 about the
+    drum's (tilted) axis for all times at once: the same as the finger frame
+    evaluated at each time (1e-12 m)."""
+    from design.solve.grasp.fingers import carried_by_drum
+
+    drum = Drum(0.368, 20 * 2 * np.pi / 60, x=0.01, tilt=tilt)
+    mount = FingerMount(angle=1.9, height=0.03, radius=0.108, phi_x=0.7, phi_y=0.26)
+    times = np.linspace(0.0, 2.0, 41)
+    base0, R0 = drum.frame(mount, 0.0)
+    base, axis = carried_by_drum(drum, times, base0, R0[:, 0])
+    for k, t in enumerate(times):
+        b, R = drum.frame(mount, t)
+        np.testing.assert_allclose(base[k], b, atol=1e-12)
+        np.testing.assert_allclose(axis[k], R[:, 0], atol=1e-12)

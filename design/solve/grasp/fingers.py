@@ -35,7 +35,7 @@ from design.physics.bird import Bird, Loads
 from design.physics.contact import ContactSolution
 from design.physics.ellipse import Ellipse
 from design.physics.grasper import Grasper
-from design.physics.kinematics import Ellipsoid
+from design.physics.kinematics import Ellipsoid, rot_y
 from design.solve.contact import RobustContact
 from design.solve.contact.spatial import (FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, segment_level)
@@ -88,38 +88,50 @@ def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end
     drum = grasper.drum(speed)
     times = np.arange(0.0, t_end + dt, dt)
     reach = max(bird.eta, bird.lam, bird.gamma)
+    centres = np.array([centre_path(t) for t in times])               # (n, 2): X, Z
+    lo = np.stack([centres[:, 0] - margin, np.zeros(times.size), np.zeros(times.size)], axis=1)
+    hi = np.stack([centres[:, 0] + margin, np.zeros(times.size), centres[:, 1] + margin], axis=1)
+    s = np.linspace(0.0, 1.0, 24)[None, :, None]
     out = []
     for gf in grasper.fingers:
-        near = np.zeros(times.size, dtype=bool)
-        for k, t in enumerate(times):
-            base, R = drum.frame(gf.mount, t)
-            tip = base + gf.finger.length * R[:, 0]
-            x_c, z_c = centre_path(t)
-            near[k] = _segment_box_distance(base, tip, (x_c - margin, x_c + margin),
-                                            (0.0, 0.0), (0.0, z_c + margin)) <= reach
-        windows = []
-        k = 0
-        while k < near.size:
-            if near[k]:
-                j = k
-                while j + 1 < near.size and near[j + 1]:
-                    j += 1
-                windows.append((max(0.0, times[k] - dt), times[j] + dt))
-                k = j + 1
-            else:
-                k += 1
-        out.append(windows)
+        base0, R0 = drum.frame(gf.mount, 0.0)
+        base, axis = carried_by_drum(drum, times, base0, R0[:, 0])
+        pts = base[:, None, :] + s * gf.finger.length * axis[:, None, :]   # (n, 24, 3)
+        gap = np.maximum(np.maximum(lo[:, None, :] - pts, 0.0), pts - hi[:, None, :])
+        near = np.min(np.linalg.norm(gap, axis=2), axis=1) <= reach
+        out.append(_windows(near, times, dt))
     return out
 
 
-def _segment_box_distance(a, b, xr, yr, zr, samples: int = 24) -> float:
-    """Smallest distance (m) from a segment to an axis-aligned box (sampled)."""
-    s = np.linspace(0.0, 1.0, samples)[:, None]
-    p = a[None, :] + s * (b - a)[None, :]
-    lo = np.array([xr[0], yr[0], zr[0]])
-    hi = np.array([xr[1], yr[1], zr[1]])
-    d = np.maximum(np.maximum(lo - p, 0.0), p - hi)
-    return float(np.min(np.linalg.norm(d, axis=1)))
+def carried_by_drum(drum, times: np.ndarray, point: np.ndarray, direction: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray]:
+    """A point and a direction fixed to the drum at t = 0, at ``times`` (n,):
+    the drum turns by -ω t about its own (tilted) axis. Returns (n, 3) each."""
+    c, s = np.cos(drum.speed * times), np.sin(drum.speed * times)
+    tilt = rot_y(drum.tilt)
+
+    def turned(v: np.ndarray) -> np.ndarray:
+        v = tilt.T @ v
+        return np.stack([c * v[0] + s * v[1], -s * v[0] + c * v[1],
+                         np.full(times.size, v[2])], axis=1) @ tilt.T
+
+    return drum.origin + turned(point - drum.origin), turned(direction)
+
+
+def _windows(near: np.ndarray, times: np.ndarray, dt: float) -> list[tuple[float, float]]:
+    """The runs of True in ``near`` as time windows padded by one sample."""
+    windows = []
+    k = 0
+    while k < near.size:
+        if near[k]:
+            j = k
+            while j + 1 < near.size and near[j + 1]:
+                j += 1
+            windows.append((max(0.0, times[k] - dt), times[j] + dt))
+            k = j + 1
+        else:
+            k += 1
+    return windows
 
 
 class ContactFailed(RuntimeError):
