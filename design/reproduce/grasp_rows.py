@@ -107,10 +107,14 @@ def family(run: GraspRun, name: str) -> str:
     return next(gf.design_name for gf in run.setup.grasper.fingers if gf.name == name)
 
 
+def touched(run: GraspRun) -> set[str]:
+    """Table 5-1's numbers of the fingers that touched."""
+    return {family(run, n) for n, f in run.summary["max_force_per_finger_N"].items() if f > 0}
+
+
 def touching(run: GraspRun) -> str:
-    """Table 5-1's numbers of the fingers that touched, e.g. '1, 2, 4, 5'."""
-    return ", ".join(sorted({family(run, n) for n, f in
-                             run.summary["max_force_per_finger_N"].items() if f > 0}))
+    """The fingers that touched as text, e.g. '1, 2, 4, 5'."""
+    return ", ".join(sorted(touched(run)))
 
 
 def peak_family(run: GraspRun) -> str:
@@ -251,7 +255,7 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         case, "finger 4 carries the ball with the drums at Table 5-1's angles at t = 0 (the "
         "phase read literally)", "finger 4 supports the weight (§5.3)",
         f"fingers touching: {touching(literal_run)}; {_motion(literal_run)}",
-        "4" in touching(literal_run).split(", "),
+        "4" in touched(literal_run),
         "The thesis prints no drum phase for the football; read literally, the ball reaches "
         "the drums between two finger sets. Criterion: finger 4 touches.")]
     start = lambda: [claim(  # noqa: E731
