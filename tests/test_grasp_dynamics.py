@@ -130,3 +130,30 @@ def test_bdf4_run_stops_when_its_newton_fails(monkeypatch):
     run = integrate(grasp, y0, 0.3, settings)
     assert not run.ok and run.message.startswith("BDF-4 step from t = 0.1000 s failed")
     assert run.records[-1].t == pytest.approx(0.1)
+
+
+def test_a_belt_that_would_pull_the_bird_down_fails_the_run(monkeypatch):
+    """N >= 0 at every recorded instant (issue 11, item 6). A finger force
+    that jumps between the event functions' evaluation and the recorded one
+    (a contact changing branch) can leave the bird in a belt mode with
+    N < 0: the run stops there, not ok, naming the time and the force,
+    instead of reporting a belt that pulls (the planar football once
+    recorded N = -38.7 N and ended 'ok'). Here the recorded evaluation sees
+    a 3 m g lift once X > -0.35 m that the event functions never see."""
+    from design.physics.bird import Loads
+    grasp = bare()
+    evaluate = grasp.fingers.evaluate
+
+    def jumping(t, y, commit=False):
+        loads, states = evaluate(t, y, commit)
+        if commit and y[0] > -0.35:
+            loads = Loads(loads.qx, loads.qz + 3 * MEAN.mass * G, loads.ty)
+        return loads, states
+
+    monkeypatch.setattr(grasp.fingers, "evaluate", jumping)
+    run = integrate(grasp, np.array([-0.4, MEAN.gamma, 0.0, 0.457, 0.0, 0.0]), 0.3,
+                    IntegratorSettings())
+    assert not run.ok and run.message.startswith("the belt pulls the bird down at t = ")
+    assert run.records[-1].normal == pytest.approx(-2 * MEAN.mass * G)
+    assert all(r.normal >= 0 for r in run.records[:-1])
+    assert run.records[-1].y[0] > -0.35 > run.records[-2].y[0]

@@ -24,7 +24,7 @@ import numpy as np
 from scipy.integrate import DOP853, RK45, Radau
 from scipy.optimize import brentq
 
-from design.physics.bird import BirdDynamics, Conveyor, Loads
+from design.physics.bird import G, BirdDynamics, Conveyor, Loads
 from design.solve.grasp.fingers import ContactFailed, FingerForces, FingerState
 from design.solve.newton import damped_newton, forward_difference
 
@@ -144,6 +144,9 @@ EVENT_ARM = {"lift-off": 1e-9, "slip": 1e-9, "stick": 1e-9, "touch-down": 0.0,
              "belt slows": 0.0, "belt steady": 0.0}
 #: this many events within a nanosecond is chattering: the run stops and says so
 MAX_EVENTS_AT_ONCE = 20
+#: a belt mode's normal force may dip below zero by this fraction of the
+#: weight (event location to 1e-12 s); more is a belt pulling the bird down
+SUPPORT_TOL = 1e-6
 
 
 def decide_mode(grasp: Grasp, t: float, y: np.ndarray, landing: bool = False):
@@ -213,8 +216,28 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
     if name == "slip":                        # the friction reached the cone: slip begins
         loads, _ = grasp.fingers.evaluate(t, y)
         _, _, friction = grasp.solve_mode(t, y, "stick", 0.0, loads)
-        return "slip", -float(np.sign(friction)) or 1.0, y
+        sign = -float(np.sign(friction)) or 1.0
+        if grasp.solve_mode(t, y, "slip", sign, loads)[1] > 0:
+            return "slip", sign, y
+        # sliding would need N < 0: decide afresh (air, if the bird lifts)
     return decide_mode(grasp, t, y, landing=name == "touch-down")
+
+
+def _keep(grasp: Grasp, traj: Trajectory, record: Record) -> bool:
+    """Append ``record``; False (the run failed, and says where) if the belt
+    would have to pull the bird down to keep it in its belt mode: a lift-off
+    the events missed because the finger forces jumped (a contact changing
+    branch between two evaluations), or friction's Painlevé paradox, which
+    this model has no impulse to resolve."""
+    traj.records.append(record)
+    weight = grasp.dyn.bird.mass * G
+    if record.mode == "air" or record.normal >= -SUPPORT_TOL * weight:
+        return True
+    traj.ok = False
+    traj.message = (f"the belt pulls the bird down at t = {record.t:.6f} s (N = "
+                    f"{record.normal:.3g} N in mode {record.mode}): the run cannot go on "
+                    f"consistently")
+    return False
 
 
 def _locate(f, dense, t_old: float, t_new: float) -> float:
@@ -237,7 +260,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
     started = time.perf_counter()
     t = 0.0
     mode, slip_sign, y = decide_mode(grasp, t, np.asarray(y0, float))
-    traj.records.append(grasp.record(t, y, mode, slip_sign))
+    if not _keep(grasp, traj, grasp.record(t, y, mode, slip_sign)):
+        return traj
     last_report = 0.0
     while t < t_end - 1e-12:
         fun = (lambda m, sg: (lambda tt, yy: grasp.rhs(tt, yy, m, sg)))(mode, slip_sign)
@@ -274,7 +298,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 traj.events.append((float(tau), name))
                 mode, slip_sign, y = _after_event(grasp, name, tau, dense(tau), mode, slip_sign)
                 t = tau
-                traj.records.append(grasp.record(t, y, mode, slip_sign))
+                if not _keep(grasp, traj, grasp.record(t, y, mode, slip_sign)):
+                    return traj
                 restart = True
                 continue
             before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
@@ -289,7 +314,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 if mode != "air":
                     mode, slip_sign, y = decide_mode(grasp, t, y)
                     record = grasp.record(t, y, mode, slip_sign)
-            traj.records.append(record)
+            if not _keep(grasp, traj, record):
+                return traj
             if progress and t - last_report >= 0.1:
                 progress(f"grasp: t = {t:.2f} s of {t_end:g} s, mode {mode}, "
                          f"{traj.steps} steps")
