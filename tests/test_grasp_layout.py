@@ -135,9 +135,10 @@ def test_the_belt_brings_a_riding_bird_by_its_speed_profile():
 def test_upstream_starts_meet_the_fingers_as_the_mean_bird_does():
     """designed_phase: a football started at Table 5-4's X0 reaches Table
     5-3's X0 = -0.075 m (riding the belt) just as every finger stands where
-    it stands at the mean bird's start: the same frames, to 1e-12 m."""
+    Table 5-1 puts it at t = 0, as the mean bird does one set period after
+    its start: the same frames, to 1e-12 m."""
     from design.reproduce.grasp import (MEAN_START, belt_arrival, football_setup,
-                                        mean_bird_setup)
+                                        mean_bird_setup, set_period)
 
     football, mean = football_setup(), mean_bird_setup("hard")
     t1 = belt_arrival(football.conveyor, football.start_x, MEAN_START)
@@ -149,3 +150,13 @@ def test_upstream_starts_meet_the_fingers_as_the_mean_bird_does():
         base_m, R_m = drum_m.frame(gf_m.mount, 0.0)
         np.testing.assert_allclose(base_f, base_m, atol=1e-12)
         np.testing.assert_allclose(R_f, R_m, atol=1e-12)
+    # the mean bird reaches X0 = -0.075 m one set period in, when the next
+    # set stands exactly where Table 5-1 puts set a at t = 0
+    period = set_period(mean.grasper)
+    assert period == pytest.approx(1.0, rel=1e-12)
+    assert mean.start_x + mean.conveyor.speed * period == pytest.approx(MEAN_START, abs=1e-12)
+    frames = [drum_m.frame(f.mount, 0.0) for f in mean.grasper.fingers]
+    for f in mean.grasper.fingers:
+        base, R = drum_m.frame(f.mount, period)
+        assert any(np.allclose(base, b, atol=1e-12) and np.allclose(R, r, atol=1e-12)
+                   for b, r in frames)

@@ -22,7 +22,8 @@ MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
 #: at the contacts lies up to 0.8-0.97 along the fingers' stiff axes, beyond
 #: the planar model's limit (design/solve/grasp/validity.py)
 VALIDATION_MODEL = "spatial"
-#: Table 5-1 angles hold for set a at t = 0; Table 5-3's 0.6 s covers set a's grasp
+#: Table 5-3's 0.6 s from X0 (Figures 5-5 to 5-9: -0.075 to +0.15 m); the
+#: football's one and a half drum cycles of video (§5.3)
 MEAN_DURATION, FOOTBALL_DURATION = 0.6, 1.6
 
 
@@ -94,11 +95,26 @@ def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard"
                       finger_model)
 
 
+def set_period(grasper, omega: float = OMEGA) -> float:
+    """Time (s) after which the next finger set stands where the last one
+    stood: 2 π / (sets ω), 1 s for Table 5-1's three sets at 20 rpm."""
+    return 2 * np.pi / (grasper.sets * omega)
+
+
 def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL) -> GraspSetup:
-    """Table 5-3's mean bird from X0 = -0.075 m, constant belt, µ = 0.4; lower
-    fingers ``hard``, ``soft`` or ``constant`` (every finger EI = 0.08 N m²)."""
+    """Table 5-3's mean bird on the constant belt, µ = 0.4; lower fingers
+    ``hard``, ``soft`` or ``constant`` (every finger EI = 0.08 N m²).
+
+    The bird arrives: it starts one set period (1 s) upstream of Table 5-3's
+    X0 = -0.075 m and reaches -0.075 m as the next set stands at Table 5-1's
+    angles, the thesis's phase, having ridden into the fingers. Placed at
+    -0.075 m at t = 0 it would start inside finger 4a's reach, held off the
+    belt (N = 0) by a finger that never swept into it (15.7 N at t = 0 with
+    soft lower fingers)."""
     s = thesis_setup(0.0, MEAN_DURATION, "hard" if lower == "constant" else lower,
                      finger_model=model)
+    lead = set_period(s.grasper, s.drum_speed)
+    s = replace(s, start_x=s.start_x - s.conveyor.speed * lead, duration=s.duration + lead)
     if lower == "constant":
         s = replace(s, grasper=with_lower(s.grasper, "thesis_uniform.yaml", ("upper", "lower")))
     return s
