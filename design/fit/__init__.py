@@ -1,0 +1,19 @@
+"""Calibrating models from measurements (``design fit``).
+
+* :mod:`design.fit.kernel`: the compliance c(s) = 1/EI(s) as a piecewise-linear
+  profile on knots, and the small-deflection kernel that makes every measured
+  deflection and slope linear in it.
+* :mod:`design.fit.convex`: the convex fit of c >= 0 (cvxpy, Clarabel) with a
+  smoothness penalty whose weight generalised cross-validation (or the
+  L-curve) picks, and its confidence band.
+* :mod:`design.fit.elastica`: predictions of the planar elastica at measured
+  points, and the nonlinear least-squares refinement on the collocated
+  elastica (CasADi + Ipopt) for large deflections.
+* :mod:`design.fit.exponential`: the thesis's exponential family
+  EI = E (A e^(a s) + B e^(b s) + C) fitted to the same measurements.
+* :mod:`design.fit.belt`: belt speed profiles from an encoder log.
+
+Conventions as in :mod:`design.physics.beam`: s is arc length from the clamp
+(m), a load of magnitude F (N) at arc length ``at`` pushes along
+F (-cos α, sin α) in the finger frame; everything is SI.
+"""
