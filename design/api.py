@@ -19,7 +19,7 @@ from design.io.contact_scene import ContactScene
 from design.io.design_problem import DesignProblem
 from design.io.grasp_scene import GraspScene
 from design.io.results import check_output_folder
-from design.io.scene import check_file, load_scene
+from design.io.scene import check_file, load_fit, load_scene
 from design.report import write_run
 from design.run import Progress, RunOutput
 from design.run import beam as beam_run
@@ -93,3 +93,26 @@ def solve(source: str | Path | Mapping, out: str | Path | None = None,
 def check(source: str | Path | Mapping) -> object:
     """Validate any input file (scene or model); returns the object it describes."""
     return check_file(source)
+
+
+def fit(source: str | Path | Mapping, out: str | Path | None = None,
+        progress: Progress | None = None) -> dict:
+    """Run a fit problem (``kind: fit``, a path or the file's content):
+    calibrate a finger's EI(s) or a belt's speed profile from measurements
+    and return the dict ``design fit`` writes to ``result.json`` (with
+    ``out``, also write it, the model file, the CSV tables and
+    ``report.html`` there). Raises :class:`~design.errors.ProblemFileError`
+    for bad input (nothing written)."""
+    from design.report.fit import write_fit
+    from design.run.fit import run as fit_run
+
+    problem = load_fit(source)
+    if out is not None:
+        check_output_folder(Path(out))
+    with interrupt.handled():
+        output = fit_run(problem, progress)
+        if not isinstance(source, Mapping):
+            output.result["scene_file"] = str(source)
+        if out is not None:
+            write_fit(Path(out), output)
+    return output.result

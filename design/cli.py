@@ -151,6 +151,12 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="skip the slow grasp figures")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=_lazy("design.reproduce.command", "cmd_reproduce"))
+    p = sub.add_parser("fit", help="calibrate a finger's EI(s) or a belt's speed profile "
+                       "from measurements; write the model file and a report")
+    p.add_argument("file", help="fit problem file (YAML, kind: fit)")
+    p.add_argument("--out", help="output folder (default: reports/<problem name>/)")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=_lazy("design.fit.command", "cmd_fit"))
     p = sub.add_parser("check", help="validate input files and report every problem")
     p.add_argument("files", nargs="+", help="scene, problem or model files (YAML)")
     p.set_defaults(func=cmd_check)

@@ -18,6 +18,7 @@ from design.io.design_problem import read_design
 from design.io.grasp_scene import MODEL_READERS, read_grasp
 from design.io.fingers import read_finger
 from design.io.files import PROBLEMS, find_scene, load_yaml
+from design.io.fit_problem import read_fit
 from design.io.reader import Reader, did_you_mean
 
 #: kind -> (required top-level keys, optional top-level keys, reader)
@@ -45,6 +46,9 @@ def load_scene(source: str | Path | Mapping) -> object:
     """
     reader, data, base_dir, name = _open(source)
     scene = None
+    if data is not None and data.get("kind") == "fit":
+        reader.add("kind", "'fit' is a fit problem: run it with 'design fit'")
+        data = None
     if data is not None:
         kind = reader.choice(data, "kind", "", list(KINDS))
         if kind is not None:
@@ -60,6 +64,8 @@ def load_scene(source: str | Path | Mapping) -> object:
 def check_file(source: str | Path | Mapping) -> object:
     """Validate any input file, scene or model; returns what it describes."""
     reader, data, base_dir, name = _open(source)
+    if isinstance(data, Mapping) and data.get("kind") == "fit":
+        return load_fit(source)
     if isinstance(data, Mapping) and data.get("kind") in MODEL_KINDS:
         kind = data["kind"]
         if kind == "finger":
@@ -70,6 +76,21 @@ def check_file(source: str | Path | Mapping) -> object:
         return model
     reader.raise_if_any()
     return load_scene(source)
+
+
+def load_fit(source: str | Path | Mapping) -> object:
+    """Read and validate a fit problem (``kind: fit``) and its data file;
+    raises :class:`ProblemFileError` with every problem found."""
+    reader, data, base_dir, name = _open(source)
+    problem = None
+    if data is not None:
+        if data.get("kind") != "fit":
+            reader.add("kind", f"{data.get('kind')!r} where a fit problem (kind: fit) is "
+                               f"expected; 'design simulate' runs scenes")
+        else:
+            problem = read_fit(reader, data, base_dir, name)
+    reader.raise_if_any()
+    return problem
 
 
 def examples() -> list[tuple[Path, str, str]]:
