@@ -123,7 +123,8 @@ def read_fit(reader: Reader, data: dict, base_dir: Path, name: str
     common = ("kind", "target", "data", "name", "description", "reference")
     target = reader.choice(data, "target", "", TARGETS)
     extra = {"finger": ("finger", "fit"), "belt": ("belt",)}.get(target, ())
-    reader.mapping(data, "", required=("kind", "target", "data", *extra[:1]),
+    required = ("finger",) if target == "finger" else ()
+    reader.mapping(data, "", required=("kind", "target", "data", *required),
                    optional=(*common, *extra))
     name = reader.text(data, "name", "", default=name)
     description = reader.text(data, "description", "", default="")
@@ -161,7 +162,7 @@ def _finger_fit(reader: Reader, data: dict, base_dir: Path, name: str, descripti
         if "reference" in data else None
     measured = None
     if path is not None and length is not None:
-        measured = read_finger_data(reader, path, length, settings)
+        measured = read_finger_data(reader, path, length, settings or FingerFitSettings())
     if not reader.ok or None in (name, description, length, settings, measured):
         return None
     return FingerFitProblem(name, path, measured, length, E, settings, reference, description)
