@@ -13,7 +13,9 @@ never start Newton from a guess that cannot be justified.
    becomes tip contact, a tip whose rod turns tangent becomes interior
    contact, a normal force that would pull is a release, a contact at the
    base leaves the model.
-4. Along a sequence of poses (time steps) each continues from the last.
+4. Along a sequence of poses (time steps) each continues from the last:
+   first in one Newton step to the new pose and friction together (the
+   usual short step), else geometry then friction in adaptive steps.
 
 Friction enters as a :class:`FrictionLaw`: a given vector (the friction
 force per unit normal force, on the finger) and/or regularised Coulomb
@@ -253,7 +255,14 @@ class SpatialContact:
                                               "pose", converged=False), None
         if segment_level(quadric, length) >= 0.0:
             return no_spatial_contact(length, "the straight finger misses the object"), None
-        # the geometry first, under the friction it had; then the friction
+        if previous is not None:
+            # the usual case, a short step: geometry and friction in one Newton
+            direct = self._step(previous, quadric, friction)
+            if isinstance(direct, SpatialState):
+                sol = self._solution(direct, "", detail)
+                sol.extras["friction_held"] = 1.0
+                return sol, direct
+        # else the geometry first, under the friction it had; then the friction
         if previous is not None:
             state, msg = self._continue(previous, quadric, previous.friction)
             if state is None and msg != BASE_REACHED:
