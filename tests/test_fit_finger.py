@@ -287,3 +287,13 @@ def test_large_deflections_are_refined_on_the_elastica_and_the_model_simulates(t
     truth = elastica_predictions(Finger(LENGTH, UniformEI(0.08)), FingerData(
         (PointLoad(2.4, np.pi / 2, 0.2),), (Observation(0, 0.2, "y", 0, 1, 0),)))[0][0]
     assert tip["y"] == pytest.approx(truth, abs=5e-4)
+
+
+def test_the_exponential_family_is_recovered_from_its_own_profile():
+    """Projecting the thesis's EI(s) (a 1 % band) onto eq. 2.33's family with
+    its rates gives back its A, B, C (the projection is exact on the family)."""
+    from design.fit.exponential import project
+
+    ei = THESIS.ei(KNOTS)
+    got = project(KNOTS, ei, 0.01 * ei, KNOTS <= 0.19, LENGTH, THESIS.E, (THESIS.a, THESIS.b))
+    assert (got.A, got.B, got.C) == pytest.approx((THESIS.A, THESIS.B, THESIS.C), rel=1e-4)

@@ -175,8 +175,9 @@ def run_finger(problem: FingerFitProblem, progress: Progress | None = None) -> R
                         f"it; the model there is the smoothness penalty's continuation "
                         f"(towards flat) of the fitted profile")
     for a, b in _ranges(knots, (knots <= reach + 1e-12) & ~determined):
-        warnings.append(f"EI(s) on [{a:.4g}, {b:.4g}] m is poorly determined: its 95 % band is "
-                        f"wider than ±{DETERMINED_BAND:.0%}")
+        where = f"at s = {a:.4g} m" if a == b else f"on [{a:.4g}, {b:.4g}] m"
+        warnings.append(f"EI(s) {where} is poorly determined: its 95 % band is wider than "
+                        f"±{DETERMINED_BAND:.0%}")
     if flagged.any():
         lines = ", ".join(str(data.observations[i].line) for i in np.flatnonzero(flagged)[:20])
         warnings.append(f"{int(flagged.sum())} measured value(s) fit badly (|studentised "
