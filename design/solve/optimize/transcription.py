@@ -318,6 +318,11 @@ class DesignNLP:
                 "intervals": self.schedule.intervals, "finger_stages": int(self.force.numel())}
 
     def solve(self) -> NLPResult:
+        """Ipopt from the simulated design's states. Records ``self.timings``
+        (also when it raises, from the point reached): ``build_s`` (nlpsol
+        with its derivative functions), ``solve_s`` (the solver call),
+        ``post_s`` (reading the solution back), CasADi's ``stats`` and the
+        number of ``finger_stages`` (design/solve/optimize/profile.py)."""
         s = self.settings
         history: list = []
         callback = _Progress(self, history, self.progress)
@@ -326,15 +331,32 @@ class DesignNLP:
                           "max_wall_time": s.max_wall_time,
                           "mu_strategy": "adaptive", **s.ipopt},
                 "print_time": False, "iteration_callback": callback,
+                # each function's wall time and calls in stats(), for the run's profile
+                "record_time": True,
                 # a rootfinder that fails at a trial point makes Ipopt shorten its step
                 "show_eval_warnings": False}
-        solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
         t0 = time.perf_counter()
-        with _casadi_output_muted() as streams:
-            callback.streams = streams
-            sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg, ubg=self.ubg)
-        wall = time.perf_counter() - t0
-        stats = solver.stats()
+        self.timings = {"finger_stages": int(self.force.numel())}
+        try:
+            solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
+        finally:
+            self.timings["build_s"] = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        try:
+            with _casadi_output_muted() as streams:
+                callback.streams = streams
+                sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg,
+                             ubg=self.ubg)
+        finally:
+            wall = self.timings["solve_s"] = time.perf_counter() - t0
+            self.timings["stats"] = _stats(solver)
+        t_post = time.perf_counter()
+        try:
+            return self._result(sol, solver.stats(), wall, history, callback)
+        finally:
+            self.timings["post_s"] = time.perf_counter() - t_post
+
+    def _result(self, sol, stats, wall, history, callback) -> NLPResult:
         checkpoint(f"in Ipopt, iteration {stats['iter_count']} of an NLP")
         if callback.error is not None:
             raise NLPFailed(f"Ipopt's iteration callback failed: {callback.error!r}") \
@@ -354,6 +376,14 @@ class DesignNLP:
                          bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
                          history, x, np.asarray(sol["lam_g"]).ravel(),
                          np.asarray(sol["lam_x"]).ravel())
+
+
+def _stats(solver) -> dict:
+    """The solver's statistics for the profile; none if it has none."""
+    try:
+        return solver.stats()
+    except RuntimeError:
+        return {}
 
 
 @contextmanager

@@ -26,6 +26,10 @@ tracking the simulated phase durations, must converge and give the same
 hold time within 2 %. That number is the optimiser's claim for the design;
 an independent simulation at a 4x finer resolution must confirm it (hold
 time within 2 %, peak force within 1 % over the cap) for the run to pass.
+
+The loop times itself (``Outcome.profile``: simulations, each NLP's
+construction, Ipopt and CasADi's function statistics, the fixed-design
+views; design/solve/optimize/profile.py) without changing what it computes.
 """
 
 from __future__ import annotations
@@ -38,6 +42,7 @@ import numpy as np
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import GraspRun, simulate_grasp
 from design.solve.grasp.validity import validity_problems
+from design.solve.optimize.profile import CONSTRUCTION, OPTIMISER, SIMULATIONS, VIEWS, Profile
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPResult, NLPSettings, Rules
 from design.solve.optimize.variables import DesignSpace
@@ -107,6 +112,8 @@ class Outcome:
     #: the optimiser's hold for ``best`` and where it comes from (None: not yet)
     claim: tuple | None = None
     wall_time: float = 0.0
+    #: where the loop's time went (its simulations, NLPs and views)
+    profile: Profile = field(default_factory=Profile)
 
     @property
     def feasible(self) -> bool:
@@ -127,7 +134,10 @@ class Outcome:
 
 def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
              integrator: IntegratorSettings | None = None) -> Evaluated:
+    """Simulate the scaled design ``d``; its summary (hold, peak force) is
+    computed here, once, so that a profile counts it with the simulation."""
     run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes)
+    run.summary  # noqa: B018  (cached on the run)
     return Evaluated(np.asarray(d, float), run)
 
 
@@ -147,13 +157,19 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
     """Maximise the hold time under the cap (N) from ``start`` (scaled; the
     baseline by default)."""
     t0 = time.perf_counter()
+    profile = Profile()
     say = progress or (lambda message: None)
     d0 = space.scale(space.base_values)
-    baseline = simulate(space, d0, settings)
-    best = baseline if start is None else simulate(space, start, settings)
+    with profile.phase(SIMULATIONS):
+        baseline = simulate(space, d0, settings)
+    if start is None:
+        best = baseline
+    else:
+        with profile.phase(SIMULATIONS):
+            best = simulate(space, start, settings)
     if start is not None and better(baseline, best, cap):
         best = baseline
-    out = Outcome(best, baseline, cap)
+    out = Outcome(best, baseline, cap, profile=profile)
     radius, backed_off = settings.radius, cap
     say(f"baseline: hold {baseline.hold:.4f} s, peak finger force {baseline.peak:.2f} N "
         f"(cap {cap:.2f} N)")
@@ -163,10 +179,9 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
         hi = np.clip(best.d + radius, 0, 1)
         say(f"outer iteration {it + 1}: trust region {radius:.3f}, NLP cap {cap_nlp:.2f} N")
         try:
-            schedule = schedule_of(best.run, settings.nlp.time_step)
-            nlp = DesignNLP(space, schedule, best.run, cap_nlp, settings.nlp, rules, (lo, hi),
-                            progress)
-            result = nlp.solve()
+            result = build_and_solve(profile, OPTIMISER, lambda: DesignNLP(
+                space, schedule_of(best.run, settings.nlp.time_step), best.run, cap_nlp,
+                settings.nlp, rules, (lo, hi), progress))
         except (RuntimeError, ValueError) as exc:
             out.iterations.append({"iteration": it + 1, "radius": radius, "error": str(exc)})
             say(f"outer iteration {it + 1}: NLP failed ({exc}); shrinking the trust region")
@@ -174,13 +189,14 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
             if radius < settings.min_radius:
                 break
             continue
-        candidate = simulate(space, result.d, settings)
+        with profile.phase(SIMULATIONS):
+            candidate = simulate(space, result.d, settings)
         accepted = better(candidate, best, cap)
         reproduced, view, view_error = None, None, None
         if accepted:
             # stand only on designs whose simulation the optimiser's grid reproduces
             try:
-                view = optimiser_view(space, candidate, settings, rules, progress)
+                view = optimiser_view(space, candidate, settings, rules, progress, profile)
             except (RuntimeError, ValueError) as exc:
                 view_error = f"the fixed-design NLP failed: {exc}"
             claim = optimiser_hold(view, result)
@@ -243,10 +259,25 @@ def optimiser_hold(view: NLPResult | None, accepted: NLPResult | None) -> tuple[
     return float("nan"), "none: the fixed-design NLP did not converge"
 
 
+def build_and_solve(profile: Profile, group: str, build) -> NLPResult:
+    """``build()`` a DesignNLP and solve it, timed in ``profile`` under
+    ``group``'s construction, Ipopt and read-back phases (also when either
+    raises)."""
+    nlp = None
+    try:
+        with profile.phase(f"{group}: {CONSTRUCTION}"):
+            nlp = build()
+        return nlp.solve()
+    finally:
+        profile.add_nlp(group, getattr(nlp, "timings", None))
+
+
 def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSettings,
-                   rules: Rules = Rules(), progress=None) -> NLPResult:
+                   rules: Rules = Rules(), progress=None, profile: Profile | None = None
+                   ) -> NLPResult:
     """The hold time on the optimiser's grid for a fixed design: the NLP with
-    the design's bounds collapsed onto it, on its own simulated schedule.
+    the design's bounds collapsed onto it, on its own simulated schedule
+    (timed in ``profile`` as a fixed-design view).
 
     Raises
     ------
@@ -254,14 +285,13 @@ def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSetti
         If the NLP cannot be built or evaluated there, or Ipopt ends on an
         error (:class:`~design.solve.optimize.transcription.NLPFailed`).
     """
-    schedule = schedule_of(evaluated.run, settings.nlp.time_step)
     # only durations and states move: allow more iterations, but stop one that
     # has stalled above feasibility (it would not reproduce the design anyway)
     nlp_settings = replace(settings.nlp, max_iter=max(settings.nlp.max_iter, VIEW_MAX_ITER),
                            stall_iterations=VIEW_STALL, stall_violation=VIEW_FEASIBLE)
-    nlp = DesignNLP(space, schedule, evaluated.run, np.inf, nlp_settings, rules,
-                    (evaluated.d, evaluated.d), progress, objective="track")
-    return nlp.solve()
+    return build_and_solve(profile or Profile(), VIEWS, lambda: DesignNLP(
+        space, schedule_of(evaluated.run, settings.nlp.time_step), evaluated.run, np.inf,
+        nlp_settings, rules, (evaluated.d, evaluated.d), progress, objective="track"))
 
 
 def reproduces(evaluated: Evaluated, claimed: float) -> bool:
@@ -278,7 +308,8 @@ def certify(space: DesignSpace, outcome: Outcome, settings: LoopSettings,
         (progress or (lambda message: None))("the optimiser's view of the design on its "
                                              "own schedule")
         try:
-            outcome.final = optimiser_view(space, outcome.best, settings, rules, progress)
+            outcome.final = optimiser_view(space, outcome.best, settings, rules, progress,
+                                           outcome.profile)
         except (RuntimeError, ValueError) as exc:
             outcome.claim = float("nan"), f"none: the fixed-design NLP failed ({exc})"
         else:

@@ -1,0 +1,234 @@
+"""Where a design run's time goes: wall time per phase, Ipopt's function
+evaluations, peak memory.
+
+A :class:`Profile` is passed through the design loop (it is an attribute of
+:class:`~design.solve.optimize.trust_region.Outcome`) and of ``design
+solve``'s run, which writes :meth:`Profile.summary` to result.json's
+``profile`` and the report's table "Where the time went". The phases do not
+overlap, so they add up to the run's wall time; what no phase covers (the
+loop's bookkeeping, progress messages) is its own row, ``unaccounted``.
+
+Phases (:data:`PHASES`): the problem's setup (which may simulate the
+baseline once to time the belt's deceleration); the loop's simulations
+(baseline, start, every candidate); for the optimiser's NLPs and for the
+fixed-design views (the NLP with the design fixed, which must reproduce a
+simulation), each of construction (the simulated schedule, the CasADi
+graph, ``nlpsol`` with its derivative functions), Ipopt (the solver call
+alone) and reading the solution back (the peak force at the solution, the
+NLP's size); the verification simulations at 4x finer resolution (the
+baseline's and each cap's design); and assembling the result. The report's
+own rendering is outside the profile (it is drawn from it).
+
+Inside each Ipopt phase, CasADi's statistics of every solve (``nlpsol``
+with ``record_time``) are summed: wall time and call count of nlp_f,
+nlp_g, nlp_grad_f, nlp_jac_g (and nlp_hess_l if an exact Hessian is used)
+and of the iteration callback; what remains of the Ipopt phase is Ipopt's
+own work (linear algebra, L-BFGS, line search) and CasADi's overhead.
+The contact rootfinders embedded in the constraints have no statistics
+CasADi accumulates over a solve (a rootfinder's ``stats()`` describe its
+last call only), so their time is inside nlp_g and nlp_jac_g; their number
+of solves is counted as finger stages x evaluations of nlp_g and nlp_jac_g
+(each evaluates every stage's rootfinder once; the Jacobian's derivatives
+reuse that solution).
+
+Peak memory is the process's peak resident set (``getrusage``'s
+``ru_maxrss``) since it started, which includes whatever ran before the
+design run in the same process.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import sys
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+#: phase names in the order tables list them
+SETUP = "problem setup"
+SIMULATIONS = "loop simulations"
+OPTIMISER, VIEWS = "optimiser NLPs", "fixed-design views"
+CONSTRUCTION, IPOPT, READ_BACK = "construction", "Ipopt", "solution read-back"
+VERIFICATION = "verification simulations (4x finer)"
+RESULT = "result assembly"
+UNACCOUNTED = "unaccounted"
+PHASES = [SETUP, SIMULATIONS,
+          *(f"{group}: {step}" for group in (OPTIMISER, VIEWS)
+            for step in (CONSTRUCTION, IPOPT, READ_BACK)),
+          VERIFICATION, RESULT]
+#: the rootfinders' row (their time is inside nlp_g and nlp_jac_g)
+ROOTFINDERS = "contact rootfinder solves"
+
+
+def peak_memory_mib() -> float:
+    """The process's peak resident set so far (MiB)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 1024 ** 2 if sys.platform == "darwin" else peak / 1024   # bytes / KiB
+
+
+@dataclass
+class NLPTotals:
+    """CasADi's statistics summed over the solves of one group of NLPs."""
+
+    solves: int = 0
+    ipopt_iterations: int = 0
+    #: Python's wall time around the solver calls (s)
+    wall_time: float = 0.0
+    #: CasADi's own total of the solver calls (s)
+    casadi_total: float = 0.0
+    #: function name -> [wall time (s), calls]
+    functions: dict = field(default_factory=dict)
+    rootfinder_solves: int = 0
+
+    def add(self, timings: dict) -> None:
+        stats = timings.get("stats") or {}
+        self.solves += 1
+        self.ipopt_iterations += int(stats.get("iter_count", 0))
+        self.wall_time += timings.get("solve_s", 0.0)
+        self.casadi_total += float(stats.get("t_wall_total", 0.0))
+        for key, value in stats.items():
+            if key.startswith("n_call_") and key != "n_call_total":
+                name = key[len("n_call_"):]
+                calls = int(value)
+                if calls:
+                    entry = self.functions.setdefault(name, [0.0, 0])
+                    entry[0] += float(stats.get(f"t_wall_{name}", 0.0))
+                    entry[1] += calls
+        evaluations = int(stats.get("n_call_nlp_g", 0)) + int(stats.get("n_call_nlp_jac_g", 0))
+        self.rootfinder_solves += int(timings.get("finger_stages", 0)) * evaluations
+
+    def merge(self, other: NLPTotals) -> None:
+        self.solves += other.solves
+        self.ipopt_iterations += other.ipopt_iterations
+        self.wall_time += other.wall_time
+        self.casadi_total += other.casadi_total
+        self.rootfinder_solves += other.rootfinder_solves
+        for name, (wall, calls) in other.functions.items():
+            entry = self.functions.setdefault(name, [0.0, 0])
+            entry[0] += wall
+            entry[1] += calls
+
+    @property
+    def ipopt_internal(self) -> float:
+        """Ipopt's own work and CasADi's overhead (s): the solver calls' wall
+        time less every function evaluation and callback."""
+        return max(self.wall_time - sum(w for w, _ in self.functions.values()), 0.0)
+
+    def summary(self) -> dict:
+        return {"solves": self.solves, "ipopt_iterations": self.ipopt_iterations,
+                "ipopt_wall_time_s": self.wall_time,
+                "casadi_total_wall_time_s": self.casadi_total,
+                "ipopt_internal_wall_time_s": self.ipopt_internal,
+                "functions": {name: {"wall_time_s": wall, "calls": calls}
+                              for name, (wall, calls) in self.functions.items()},
+                "rootfinder_solves": self.rootfinder_solves}
+
+
+@dataclass
+class Profile:
+    """Wall time (s) and count per phase, CasADi's statistics per NLP group,
+    from its creation (the run's start) on."""
+
+    started: float = field(default_factory=time.perf_counter)
+    cpus: int | None = field(default_factory=os.cpu_count)
+    load_average: tuple = field(default_factory=os.getloadavg)
+    #: phase -> [wall time (s), count]
+    phases: dict = field(default_factory=dict)
+    #: group (OPTIMISER, VIEWS) -> NLPTotals
+    nlps: dict = field(default_factory=dict)
+
+    def add(self, phase: str, seconds: float, count: int = 1) -> None:
+        entry = self.phases.setdefault(phase, [0.0, 0])
+        entry[0] += seconds
+        entry[1] += count
+
+    @contextmanager
+    def phase(self, name: str):
+        """Time the block as one call of ``name`` (also when it raises)."""
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.add(name, time.perf_counter() - t0)
+
+    def add_nlp(self, group: str, timings: dict | None) -> None:
+        """One NLP solve's ``timings`` (DesignNLP.timings: ``build_s`` of
+        nlpsol, ``solve_s``, ``post_s``, CasADi's ``stats``, ``finger_stages``);
+        None (the NLP was not built or not solved): nothing to add."""
+        if not timings:
+            return
+        self.add(f"{group}: {CONSTRUCTION}", timings.get("build_s", 0.0), 0)
+        if "solve_s" in timings:
+            self.add(f"{group}: {IPOPT}", timings["solve_s"])
+            self.nlps.setdefault(group, NLPTotals()).add(timings)
+        if "post_s" in timings:
+            self.add(f"{group}: {READ_BACK}", timings["post_s"])
+
+    def merge(self, other: Profile) -> None:
+        """Add another profile's phases and NLP statistics (not its clock)."""
+        for name, (wall, count) in other.phases.items():
+            self.add(name, wall, count)
+        for group, totals in other.nlps.items():
+            self.nlps.setdefault(group, NLPTotals()).merge(totals)
+
+    def summary(self) -> dict:
+        """result.json's ``profile``: the phases in order with the unaccounted
+        rest, each NLP group's CasADi statistics, peak memory, the machine."""
+        total = time.perf_counter() - self.started
+        order = PHASES + [p for p in self.phases if p not in PHASES]
+        phases = [{"phase": p, "wall_time_s": self.phases[p][0], "calls": self.phases[p][1]}
+                  for p in order if p in self.phases]
+        accounted = sum(p["wall_time_s"] for p in phases)
+        phases.append({"phase": UNACCOUNTED, "wall_time_s": max(total - accounted, 0.0),
+                       "calls": None})
+        return {"wall_time_s": total, "phases": phases,
+                "nlp": {group: totals.summary() for group, totals in self.nlps.items()},
+                "peak_memory_MiB": peak_memory_mib(),
+                "machine": {"cpus": self.cpus, "load_average_at_start": list(self.load_average),
+                            # BLAS threads change the linear algebra's speed on 2 shared cores
+                            "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS")}}
+
+
+def profile_rows(profile: dict) -> list[dict]:
+    """The table "Where the time went": every phase with its wall time (s),
+    share of the total (%) and calls, each Ipopt phase followed by its
+    breakdown (rows marked ↳, not to be added again), then the total."""
+    total = profile["wall_time_s"]
+
+    def row(name, wall, calls):
+        return {"phase": name, "wall time (s)": wall,
+                "share of total (%)": None if wall is None else 100 * wall / total if total > 0
+                else 0.0, "calls": calls}
+
+    rows = []
+    for p in profile["phases"]:
+        rows.append(row(p["phase"], p["wall_time_s"], p["calls"]))
+        group, _, step = p["phase"].partition(": ")
+        if step != IPOPT or group not in profile["nlp"]:
+            continue
+        n = profile["nlp"][group]
+        for name, f in sorted(n["functions"].items(), key=lambda kv: -kv[1]["wall_time_s"]):
+            rows.append(row(f"↳ {name}", f["wall_time_s"], f["calls"]))
+        rows.append(row(f"↳ Ipopt itself and CasADi overhead ({n['ipopt_iterations']} "
+                        "iterations)", n["ipopt_internal_wall_time_s"], n["solves"]))
+        rows.append(row(f"↳ {ROOTFINDERS} (time inside nlp_g, nlp_jac_g)", None,
+                        n["rootfinder_solves"]))
+    rows.append(row("total", total, None))
+    return rows
+
+
+def profile_text(profile: dict) -> str:
+    """:func:`profile_rows` as a plain-text table, with peak memory and the
+    machine's cores and load."""
+    lines = [f"{'phase':64} {'wall s':>9} {'share %':>8} {'calls':>9}"]
+    for r in profile_rows(profile):
+        wall = "-" if r["wall time (s)"] is None else f"{r['wall time (s)']:9.2f}"
+        share = "-" if r["share of total (%)"] is None else f"{r['share of total (%)']:8.1f}"
+        calls = "" if r["calls"] is None else str(r["calls"])
+        lines.append(f"{r['phase']:64} {wall:>9} {share:>8} {calls:>9}")
+    m = profile["machine"]
+    load = ", ".join(f"{x:.2f}" for x in m["load_average_at_start"])
+    lines.append(f"peak memory {profile['peak_memory_MiB']:.0f} MiB; {m['cpus']} cores, load "
+                 f"average {load} at the start")
+    return "\n".join(lines)
