@@ -8,6 +8,7 @@ from matplotlib.figure import Figure
 from design.report.grasp import grasp_figures, reproduce_section, summary_rows
 from design.report.page import Page
 from design.solve.grasp.simulation import GraspRun
+from design.solve.optimize.profile import profile_rows
 
 
 def verification_rows(result: dict) -> list[dict]:
@@ -64,6 +65,20 @@ def pareto_figure(rows: list[dict], baseline: dict) -> Figure:
     ax.grid(alpha=0.3)
     ax.legend()
     return fig
+
+
+def profile_table(page: Page, profile: dict) -> None:
+    """The table "Where the time went" (result.json's ``profile``) and the
+    run's peak memory, cores and load."""
+    m = profile["machine"]
+    load = ", ".join(f"{x:.2f}" for x in m["load_average_at_start"])
+    page.text(f"Where the time went: {profile['wall_time_s']:.1f} s of wall time in all, "
+              f"peak memory {profile['peak_memory_MiB']:.0f} MiB, on {m['cpus']} cores with a "
+              f"load average of {load} at the start. The phases do not overlap and add up to "
+              "the total with the unaccounted rest; rows marked ↳ break down the Ipopt phase "
+              "above them (CasADi's statistics) and are not added again. The contact "
+              "rootfinders' time is inside nlp_g and nlp_jac_g.")
+    page.table(profile_rows(profile), "Where the time went", "profile-table")
 
 
 def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
@@ -123,6 +138,8 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     if any(h.get("history") for h in history):
         page.figure(convergence_figure(history), "convergence",
                     "Ipopt convergence: the NLP's hold time and its constraint violation")
+    if result.get("profile"):
+        profile_table(page, result["profile"])
     if result.get("pareto"):
         page.section("Hold time against the cap", "pareto")
         page.table(result["pareto"], "Pareto study", "pareto-table")

@@ -8,6 +8,9 @@ accepted no design and the baseline, which keeps the cap, is the answer;
 the design breaks the cap; ``error`` (1), the optimiser could not work
 (every NLP failed, or it could not evaluate its own design). Bad input (2)
 and Ctrl-C (130) write no result.
+
+result.json's ``profile`` says where the run's time went (wall time per
+phase, Ipopt's function evaluations, peak memory: design/solve/optimize/profile.py).
 """
 
 from __future__ import annotations
@@ -23,6 +26,7 @@ from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
+from design.solve.optimize.profile import RESULT, SETUP, VERIFICATION, Profile
 from design.solve.optimize.transcription import rule_margins
 from design.solve.optimize.trust_region import Outcome, certify, optimise, verdict, verify
 from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
@@ -56,12 +60,15 @@ def design_space(problem: DesignProblem, progress: Progress | None = None) -> De
 
 def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
     t0 = time.perf_counter()
+    profile = Profile()
     say = progress or (lambda message: None)
-    space = design_space(problem, progress)
+    with profile.phase(SETUP):
+        space = design_space(problem, progress)
     settings = problem.settings
     d0 = space.scale(space.base_values)
     say("simulating the baseline at 4x the optimiser's resolution")
-    baseline = verify(space, d0, settings)
+    with profile.phase(VERIFICATION):
+        baseline = verify(space, d0, settings)
     caps = [c.resolve(baseline.peak) for c in problem.caps]
     entries, outcomes, start = {}, {}, None
     # tightest cap first: each design is then feasible for the next, looser
@@ -72,12 +79,25 @@ def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
         outcome = optimise(space, cap, settings, problem.rules, start, progress)
         claim = certify(space, outcome, settings, problem.rules, progress)
         say("verifying at 4x finer resolution")
-        fine = verify(space, outcome.best.d, settings)
-        entries[k] = _entry(space, problem, outcome, claim, fine, cap, cap_spec)
+        with profile.phase(VERIFICATION):
+            fine = verify(space, outcome.best.d, settings)
+        with profile.phase(RESULT):
+            entries[k] = _entry(space, problem, outcome, claim, fine, cap, cap_spec)
+        profile.merge(outcome.profile)
         outcomes[k] = (outcome, fine)
         start = outcome.best.d
-    entries = [entries[k] for k in range(len(caps))]
-    primary, (outcome, fine) = entries[0], outcomes[0]
+    with profile.phase(RESULT):
+        output = _output(problem, space, [entries[k] for k in range(len(caps))], outcomes[0],
+                         baseline, t0)
+    output.result["profile"] = profile.summary()
+    return output
+
+
+def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], primary_outcome,
+            baseline, t0: float) -> RunOutput:
+    """The run's result, tables and files; the first cap's entry is the
+    primary one (its design and verification are reported)."""
+    primary, (outcome, fine) = entries[0], primary_outcome
     status, message = overall_status(entries)
     result = {
         "kind": "design", "name": problem.name, "toolkit_version": __version__,
