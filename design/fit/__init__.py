@@ -10,7 +10,7 @@
   points, and the nonlinear least-squares refinement on the collocated
   elastica (CasADi + Ipopt) for large deflections.
 * :mod:`design.fit.exponential`: the thesis's exponential family
-  EI = E (A e^(a s) + B e^(b s) + C) fitted to the same measurements.
+  EI = E (A e^(a s) + B e^(b s) + C) projected onto a fitted profile.
 * :mod:`design.fit.belt`: belt speed profiles from an encoder log.
 
 Conventions as in :mod:`design.physics.beam`: s is arc length from the clamp

@@ -11,9 +11,10 @@ with σ the stated measurement noise, D the second differences on the knots
 (a roughness penalty) and c_ref a scale (the best uniform compliance). It is
 a cvxpy problem solved by Clarabel: an interior-point method that solves a
 QP's quadratic objective directly (no cone reformulation) to 1e-8 relative
-accuracy, where OSQP (ADMM, first order) stops at about 1e-4, too coarse to
-compare the residuals of neighbouring weights; and it is free, bundled with
-cvxpy, and deterministic.
+accuracy, where OSQP (ADMM, first order) stops at its 1e-5 tolerances (as
+cvxpy sets them) and converges slowly past them: the weight's choice
+compares the residuals of neighbouring weights, which needs the former. It
+is also free, installed with cvxpy, and deterministic.
 
 The weight λ is not a constant: it is chosen among a log-spaced grid by a
 stated rule,
@@ -34,9 +35,9 @@ stated rule,
 The band is Wahba's (1983) Bayesian one: Cov(c) = σ̂² (AᵀA + λDᵀD)⁻¹
 (scaled), with σ̂² = ‖r‖² / (m - tr H), the noise the residuals show
 (relative to the stated σ); the constraints are left out of it, so that a
-bound active at the solution does not make its neighbourhood look certain. It reflects the data's sensitivity to each
-knot: where no measurement depends on c the band is as wide as the
-penalty leaves it.
+bound active at the solution does not make its neighbourhood look certain.
+It reflects the data's sensitivity to each knot: where no measurement
+depends on c the band is as wide as the penalty leaves it.
 """
 
 from __future__ import annotations

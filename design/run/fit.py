@@ -33,7 +33,8 @@ DETERMINED_BAND = 0.25
 COMPLIANCE_FLOOR = 1e-2
 SOLVER_WHY = ("Clarabel (interior point, through cvxpy): solves the QP's quadratic objective "
               "directly to ~1e-8 relative accuracy, enough to compare the residuals of "
-              "neighbouring weights, where OSQP (first-order ADMM) stops near 1e-4")
+              "neighbouring weights; OSQP (first-order ADMM) stops at 1e-5 tolerances and "
+              "converges slowly past them")
 
 
 def run(problem, progress: Progress | None = None) -> RunOutput:
