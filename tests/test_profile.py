@@ -45,7 +45,9 @@ def test_phases_account_for_the_run(solved):
     profile = solved[0]["profile"]
     total = profile["wall_time_s"]
     phases = {p["phase"]: p for p in profile["phases"]}
-    assert total > 0 and all(p["wall_time_s"] >= 0 for p in phases.values())
+    assert total > 0 and all(p["wall_time_s"] >= 0 and p["cpu_time_s"] >= 0
+                             for p in phases.values())
+    assert 0 < profile["cpu_time_s"]
     named = sum(p["wall_time_s"] for name, p in phases.items() if name != UNACCOUNTED)
     assert named <= total
     assert named >= 0.9 * total                             # little left unaccounted
@@ -68,6 +70,7 @@ def test_casadi_statistics_of_every_nlp_that_ran(solved):
             calls = n["functions"][name]["calls"]
             assert isinstance(calls, int) and calls > 0
             assert n["functions"][name]["wall_time_s"] >= 0
+            assert n["functions"][name]["cpu_time_s"] >= 0
         # the evaluations and Ipopt's own work are the Ipopt phase's wall time
         evaluations = sum(f["wall_time_s"] for f in n["functions"].values())
         assert evaluations <= n["ipopt_wall_time_s"] == phases[f"{group}: {IPOPT}"]
@@ -93,15 +96,19 @@ def test_a_phase_that_raises_is_still_timed_and_profiles_merge():
             raise ValueError
     b.add("x", 1.0, 2)
     b.add_nlp(VIEWS, {"build_s": 0.5, "solve_s": 2.0, "post_s": 0.1, "finger_stages": 10,
+                      "solve_cpu_s": 1.0,
                       "stats": {"iter_count": 3, "n_call_nlp_g": 4, "t_wall_nlp_g": 1.5,
-                                "n_call_nlp_jac_g": 1, "t_wall_nlp_jac_g": 0.25,
+                                "t_proc_nlp_g": 0.5, "n_call_nlp_jac_g": 1,
+                                "t_wall_nlp_jac_g": 0.25, "t_proc_nlp_jac_g": 0.25,
                                 "n_call_nlp_grad": 0, "t_wall_nlp_grad": 0.0}})
     b.add_nlp(OPTIMISER, None)                         # never built: nothing
     a.merge(b)
     assert a.phases["x"][0] >= 1.01 and a.phases["x"][1] == 3
     s = a.summary()["nlp"][VIEWS]
-    assert s["functions"] == {"nlp_g": {"wall_time_s": 1.5, "calls": 4},
-                              "nlp_jac_g": {"wall_time_s": 0.25, "calls": 1}}
+    assert s["functions"] == {"nlp_g": {"wall_time_s": 1.5, "cpu_time_s": 0.5, "calls": 4},
+                              "nlp_jac_g": {"wall_time_s": 0.25, "cpu_time_s": 0.25,
+                                            "calls": 1}}
     assert s["ipopt_internal_wall_time_s"] == pytest.approx(0.25)
+    assert s["ipopt_internal_cpu_time_s"] == pytest.approx(0.25)
     assert s["rootfinder_solves"] == 50
     assert OPTIMISER not in a.summary()["nlp"]

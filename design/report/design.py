@@ -72,9 +72,10 @@ def profile_table(page: Page, profile: dict) -> None:
     run's peak memory, cores and load."""
     m = profile["machine"]
     load = ", ".join(f"{x:.2f}" for x in m["load_average_at_start"])
-    page.text(f"Where the time went: {profile['wall_time_s']:.1f} s of wall time in all, "
-              f"peak memory {profile['peak_memory_MiB']:.0f} MiB, on {m['cpus']} cores with a "
-              f"load average of {load} at the start. The phases do not overlap and add up to "
+    page.text(f"Where the time went: {profile['wall_time_s']:.1f} s of wall time in all "
+              f"({profile.get('cpu_time_s', float('nan')):.1f} s of CPU time), peak memory "
+              f"{profile['peak_memory_MiB']:.0f} MiB, on {m['cpus']} cores with a load average "
+              f"of {load} at the start. The phases do not overlap and add up to "
               "the total with the unaccounted rest; rows marked ↳ break down the Ipopt phase "
               "above them (CasADi's statistics) and are not added again. The contact "
               "rootfinders' time is inside nlp_g and nlp_jac_g.")

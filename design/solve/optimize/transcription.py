@@ -319,9 +319,10 @@ class DesignNLP:
 
     def solve(self) -> NLPResult:
         """Ipopt from the simulated design's states. Records ``self.timings``
-        (also when it raises, from the point reached): ``build_s`` (nlpsol
-        with its derivative functions), ``solve_s`` (the solver call),
-        ``post_s`` (reading the solution back), CasADi's ``stats`` and the
+        (also when it raises, from the point reached): wall and CPU time
+        (s) of ``build`` (nlpsol with its derivative functions), ``solve``
+        (the solver call) and ``post`` (reading the solution back) as
+        ``build_s``, ``build_cpu_s`` and so on, CasADi's ``stats`` and the
         number of ``finger_stages`` (design/solve/optimize/profile.py)."""
         s = self.settings
         history: list = []
@@ -331,30 +332,33 @@ class DesignNLP:
                           "max_wall_time": s.max_wall_time,
                           "mu_strategy": "adaptive", **s.ipopt},
                 "print_time": False, "iteration_callback": callback,
-                # each function's wall time and calls in stats(), for the run's profile
+                # each function's wall and CPU time and calls in stats(), for the run's profile
                 "record_time": True,
                 # a rootfinder that fails at a trial point makes Ipopt shorten its step
                 "show_eval_warnings": False}
-        t0 = time.perf_counter()
         self.timings = {"finger_stages": int(self.force.numel())}
-        try:
+        with self._timed("build"):
             solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
-        finally:
-            self.timings["build_s"] = time.perf_counter() - t0
-        t0 = time.perf_counter()
         try:
-            with _casadi_output_muted() as streams:
+            with self._timed("solve"), _casadi_output_muted() as streams:
                 callback.streams = streams
                 sol = solver(x0=self.x0, lbx=self.lbx, ubx=self.ubx, lbg=self.lbg,
                              ubg=self.ubg)
         finally:
-            wall = self.timings["solve_s"] = time.perf_counter() - t0
             self.timings["stats"] = _stats(solver)
-        t_post = time.perf_counter()
+        with self._timed("post"):
+            return self._result(sol, solver.stats(), self.timings["solve_s"], history, callback)
+
+    @contextmanager
+    def _timed(self, step: str):
+        """Record the block's wall and CPU time (s) as ``timings[step_s]`` and
+        ``timings[step_cpu_s]``, also when it raises."""
+        wall, cpu = time.perf_counter(), time.process_time()
         try:
-            return self._result(sol, solver.stats(), wall, history, callback)
+            yield
         finally:
-            self.timings["post_s"] = time.perf_counter() - t_post
+            self.timings[f"{step}_s"] = time.perf_counter() - wall
+            self.timings[f"{step}_cpu_s"] = time.process_time() - cpu
 
     def _result(self, sol, stats, wall, history, callback) -> NLPResult:
         checkpoint(f"in Ipopt, iteration {stats['iter_count']} of an NLP")
