@@ -101,7 +101,8 @@ def set_period(grasper, omega: float = OMEGA) -> float:
     return 2 * np.pi / (grasper.sets * omega)
 
 
-def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL) -> GraspSetup:
+def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL,
+                    arriving: bool = True) -> GraspSetup:
     """Table 5-3's mean bird on the constant belt, µ = 0.4; lower fingers
     ``hard``, ``soft`` or ``constant`` (every finger EI = 0.08 N m²).
 
@@ -110,11 +111,12 @@ def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL) -> Grasp
     angles, the thesis's phase, having ridden into the fingers. Placed at
     -0.075 m at t = 0 it would start inside finger 4a's reach, held off the
     belt (N = 0) by a finger that never swept into it (15.7 N at t = 0 with
-    soft lower fingers)."""
+    soft lower fingers); ``arriving=False`` runs that start as printed."""
     s = thesis_setup(0.0, MEAN_DURATION, "hard" if lower == "constant" else lower,
                      finger_model=model)
-    lead = set_period(s.grasper, s.drum_speed)
-    s = replace(s, start_x=s.start_x - s.conveyor.speed * lead, duration=s.duration + lead)
+    if arriving:
+        lead = set_period(s.grasper, s.drum_speed)
+        s = replace(s, start_x=s.start_x - s.conveyor.speed * lead, duration=s.duration + lead)
     if lower == "constant":
         s = replace(s, grasper=with_lower(s.grasper, "thesis_uniform.yaml", ("upper", "lower")))
     return s
