@@ -88,6 +88,25 @@ def test_bending_planes():
         assert np.sign(up[0]) == sign
 
 
+def test_upper_fingers_clear_the_resting_mean_bird_but_cut_the_football():
+    """§5.1: fingers 1 and 2 restrain the bird's rise from above. Facing the
+    bird, the straight upper fingers pass over the resting mean bird (Table
+    5-3: 97, 66, 57 mm) but through the resting football (Table 5-4: 122,
+    66, 66 mm): their axes come within 54.2 mm of the ball's long axis, 11.8
+    mm inside its round 66 mm section, and closer as the ball rises. So with
+    Table 5-1's upper fingers as printed they press the football down
+    wherever it is lifted (design reproduce: clamped between fingers 1a, 2a
+    and 4a, centre rise 9.8 mm, not the thesis's 18 mm)."""
+    for name in ("1a", "2a"):
+        m = finger(name).mount
+        base, R = DRUM.frame(m, (m.angle - np.pi / 2) / OMEGA)       # facing the bird
+        pts = base[:, None] + np.outer(R[:, 0], np.linspace(0, finger(name).finger.length, 400))
+        mean = Ellipsoid(0.097, 0.066, 0.057, (base[0], 0.0, 0.057))
+        ball = Ellipsoid(0.122, 0.066, 0.066, (base[0], 0.0, 0.066))
+        assert np.min(mean.level(pts)) > 0 > np.min(ball.level(pts))
+        assert np.min(np.hypot(pts[1], pts[2] - 0.066)) == pytest.approx(0.0542, abs=5e-4)
+
+
 def reached_fingers(x0: float, duration: float) -> set[str]:
     """Designed fingers whose straight copies enter the resting mean bird
     (Table 5-3) carried from X0 at 0.457 m/s, sampled every millisecond."""
