@@ -3,6 +3,7 @@ writes nothing (or every file) and exits 130; CasADi never turns the
 interrupt into a failed solve that changes the answer."""
 
 import os
+import pickle
 import signal
 import subprocess
 import sys
@@ -17,7 +18,7 @@ import pytest
 from design.errors import Interrupted
 from design.interrupt import handled, requested, stopped
 from design.io.results import write_atomic
-from tests.design_cases import short_problem_file
+from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
 
 ROOT = Path(__file__).resolve().parents[1]
 #: from Ctrl-C to the process's exit (s): the goal is 1 s; the rest is room
@@ -95,13 +96,22 @@ def test_ctrl_c_while_writing_lets_every_file_be_written(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report.html", "result.json"]
 
 
+#: the child's last stderr line: when its command returned (time.monotonic,
+#: one clock for every process on the machine)
+RETURNED = "command returned at monotonic time "
+
+
 def run_and_interrupt(args: list[str], cue: str, tmp_path: Path, timeout: float = 60.0,
-                      prelude: str = "") -> tuple[int, float, str]:
+                      prelude: str = "") -> tuple[int, float, str, str]:
     """Run ``design args`` in a child process (its own session, as a
     terminal's Ctrl-C reaches a foreground job), send SIGINT to its group on
     the first progress line containing ``cue``; (exit status, seconds from
-    the SIGINT to the exit, stderr)."""
-    code = f"{prelude}\nimport sys\nfrom design.cli import main\nsys.exit(main({args!r}))"
+    the SIGINT to the exit, what they were spent on, stderr). The child's
+    start-up is before the cue, so not in the time; of the time, the command
+    itself takes milliseconds to stop and return, the interpreter's exit
+    (module teardown) 0.2-0.5 s on the 2-core test machine."""
+    code = (f"{prelude}\nimport sys, time\nfrom design.cli import main\nstatus = main({args!r})"
+            f"\nprint(f'{RETURNED}{{time.monotonic()!r}}', file=sys.stderr)\nsys.exit(status)")
     child = subprocess.Popen([sys.executable, "-c", code], cwd=tmp_path, text=True,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                              start_new_session=True)
@@ -114,10 +124,16 @@ def run_and_interrupt(args: list[str], cue: str, tmp_path: Path, timeout: float 
             assert time.monotonic() < deadline, "".join(lines)
         else:
             pytest.fail("the run ended before its cue:\n" + "".join(lines))
-        os.killpg(child.pid, signal.SIGINT)
         sent = time.monotonic()
+        os.killpg(child.pid, signal.SIGINT)
         rest = child.communicate(timeout=30)[1]
-        return child.returncode, time.monotonic() - sent, "".join(lines) + rest
+        took = time.monotonic() - sent
+        returned = [float(line.removeprefix(RETURNED)) for line in rest.splitlines()
+                    if line.startswith(RETURNED)]
+        spent = (f"{took:.2f} s from Ctrl-C to exit, of which "
+                 f"{returned[0] - sent if returned else float('nan'):.3f} s to return from "
+                 f"the command, the rest the interpreter's exit")
+        return child.returncode, took, spent, "".join(lines) + rest
     finally:
         if child.poll() is None:
             child.kill()
@@ -126,11 +142,11 @@ def run_and_interrupt(args: list[str], cue: str, tmp_path: Path, timeout: float 
 
 def test_ctrl_c_stops_design_simulate_on_a_grasp_scene(tmp_path):
     out = tmp_path / "out"
-    code, took, stderr = run_and_interrupt(
+    code, took, spent, stderr = run_and_interrupt(
         ["simulate", str(ROOT / "problems" / "grasp_mean_bird_hard.yaml"), "--out", str(out)],
         "grasp: t = 0.2", tmp_path)
     assert code == 130, stderr
-    assert took < PROMPT, took
+    assert took < PROMPT, spent
     assert "interrupted (Ctrl-C): stopped" in stderr and "nothing was written" in stderr
     assert "Traceback" not in stderr
     assert not out.exists() or not any(out.iterdir())
@@ -138,16 +154,14 @@ def test_ctrl_c_stops_design_simulate_on_a_grasp_scene(tmp_path):
 
 #: the child's simulations: the baseline's, at the grasp scenes' default
 #: tolerance, stands for every design's, so that the optimiser starts within
-#: seconds (its NLP and Ipopt iterations are real)
+#: seconds (its NLP and Ipopt iterations are real); the run is the session's
+#: (tests/design_cases.py, shared with test_run_status.py), handed over pickled
 QUICK_SIMULATIONS = """
-from design.solve.grasp import simulation
+import pickle
 from design.solve.optimize import trust_region
-baseline = []
-def simulate_grasp(setup, *args, **kwargs):
-    if not baseline:
-        baseline.append(simulation.simulate_grasp(setup))
-    return baseline[0]
-trust_region.simulate_grasp = simulate_grasp
+with open({path!r}, "rb") as f:
+    baseline = pickle.load(f)
+trust_region.simulate_grasp = lambda setup, *args, **kwargs: baseline
 """
 
 
@@ -155,12 +169,14 @@ def test_ctrl_c_stops_design_solve_in_ipopt_and_claims_nothing(tmp_path):
     problem = short_problem_file(tmp_path / "problem.yaml",
                                  {"groups.upper.stiffness_scale": [0.5, 1.5]},
                                  max_iter=200, outer_iterations=3)
+    baseline = tmp_path / "baseline.pickle"
+    baseline.write_bytes(pickle.dumps(shared_simulate_grasp(short_setup())))
     out = tmp_path / "out"
-    code, took, stderr = run_and_interrupt(["solve", str(problem), "--out", str(out)],
-                                           "ipopt iteration 0:", tmp_path,
-                                           prelude=QUICK_SIMULATIONS)
+    code, took, spent, stderr = run_and_interrupt(
+        ["solve", str(problem), "--out", str(out)], "ipopt iteration 0:", tmp_path,
+        prelude=QUICK_SIMULATIONS.format(path=str(baseline)))
     assert code == 130, stderr
-    assert took < PROMPT, took
+    assert took < PROMPT, spent
     assert "interrupted (Ctrl-C): stopped" in stderr and "nothing was written" in stderr
     assert "Traceback" not in stderr
     assert "rejected" not in stderr and "accepted" not in stderr    # no outer iteration ended

@@ -12,14 +12,13 @@ import pytest
 
 from design.cli import main
 from design.run.solve import ERROR, FAILED, NO_IMPROVEMENT, VERIFIED, overall_status
-from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.transcription import DesignNLP, NLPResult
-from tests.design_cases import short_problem_file, short_setup
+from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
 
 
 @pytest.fixture(scope="module")
 def one_run():
-    return simulate_grasp(short_setup())
+    return shared_simulate_grasp(short_setup())         # also test_interrupt.py's
 
 
 @pytest.fixture
