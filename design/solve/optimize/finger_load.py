@@ -3,59 +3,86 @@
 The same chain as the simulator (design/solve/grasp/fingers.py): the finger's
 frame on the drum, the ellipse in which its bending plane cuts the bird
 (as a conic, smooth in the pose), the collocated contact equations solved by
-a CasADi rootfinder (derivatives by the implicit-function theorem), the
-force mapped back to the world and doubled for the mirror finger. Built
-once per finger and contact mode; called at every stage of the time grid.
+a CasADi rootfinder, the force mapped back to the world and doubled for the
+mirror finger. Built once per finger and contact mode; called at every stage
+of the time grid.
 
 Inputs: bird pose (X, Z, θ) (m, rad), time t (s), the finger's design
 fp = (angle, height, drum radius, φx, φy, length) (rad, m), the drums'
 g = (spacing, speed) (m, rad/s), the stiffness scale k, the signed friction
 τµ and the rootfinder's start z0. Outputs: the load on the bird from both
 drums (Q_X, Q_Z, T_Y) (N, N, N m), the contact force magnitude clipped at
-zero (N; a contact that would pull lets go), the unclipped force (N) and z.
+zero (N; a contact that would pull lets go) and the contact's unknowns z
+(an output to read, declared not differentiable).
+
+How it is evaluated (issue 13): the function is three calls, the kinematics
+x -> q (SX), the rootfinder (z0, q) -> z and the loads (x, z) -> outputs
+(SX), and its Jacobian is given explicitly (``custom_jacobian``) by the
+implicit-function theorem at the solution z it already has,
+
+    d out/dx = ∂out/∂x + ∂out/∂z dz/dx = ∂out/∂x - λᵀ R_x,
+    dz/dx = -R_z⁻¹ R_x,   λ = R_z⁻ᵀ (∂out/∂z)ᵀ   (R_x = ∂R/∂q ∂q/∂x),
+
+one sparse QR of R_zᵀ with the four outputs as right-hand sides (the
+adjoint λ) per stage, instead of CasADi's derivative of the rootfinder, which
+solved the contact again inside every derivative call and carried every
+seed through the kinematics' MX graph. Measured on the first NLP of
+problems/hold_time.yaml (617 finger stages): one constraint Jacobian
+0.31 -> 0.11 s CPU, the same to 9e-14 relative; the rootfinder is the
+same (Newton with line search, CasADi's sparse QR), with the residual's
+Jacobian compiled: the same iterates to the last bit.
+
+The SX parts are generic in a constants vector c (the grasper's position
+and tilt, the bird's semi-axes, the finger's reference rigidity, mesh and
+stiffness parameters), so that one compiled library serves every finger
+of a stiffness structure and every problem (design/solve/compiled.py:
+C code compiled once and cached on disk; interpreted when no compiler).
 """
 
 from __future__ import annotations
 
 import casadi as ca
+import numpy as np
 
 from design.physics.bird import Bird
 from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import finger_frame, section
+from design.solve.compiled import compiled
 from design.solve.contact.equations import MODES, contact_transcription
 from design.solve.contact.robust import RobustContact
 
 #: Newton tolerance and iteration limit inside the NLP
 TOLERANCE, MAX_ITER = 1e-10, 30
+#: the inputs and outputs of a finger's function
+INPUTS = ["pose", "t", "fp", "g", "k", "tau_mu", "z0"]
+OUTPUTS = ["load", "force", "z"]
+DIFFERENTIABLE = [True, True, False]
+#: sizes of the differentiable inputs (all but z0), in INPUTS' order
+SIZES = {"pose": 3, "t": 1, "fp": 6, "g": 2, "k": 1, "tau_mu": 1}
+#: index of the constants in c: grasper x, tilt, bird η, λ, γ, EI_ref, then widths, params
+N_FIXED = 6
 
 
-class FingerLoad:
-    """``functions[mode]`` for one finger (mode ``interior`` or ``tip``)."""
+class StageFunctions:
+    """The generic SX parts of one contact transcription (stiffness
+    structure, mesh, mode): kinematics, loads and their Jacobian blocks, as
+    functions of x = (pose, t, fp, g, k, τµ), z and the constants c; with
+    the rootfinder that uses the (compiled) residual Jacobian."""
 
-    def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
-                 intervals: int, degree: int = 4):
-        # the simulator's mesh and reference rigidity, so that its z are guesses here
-        reference = RobustContact(gf.finger, friction, intervals, degree)
-        self.ei_ref, self.widths = reference.ei_ref, reference.widths
-        self.n_z = {}
-        self.functions = {m: self._build(gf, grasper, bird, intervals, degree, m) for m in MODES}
-
-    def _build(self, gf, grasper, bird, intervals, degree, mode) -> ca.Function:
-        stiffness = gf.finger.stiffness
-        tr = contact_transcription(stiffness, intervals, degree, mode, ellipse="conic")
-        self.n_z[mode] = tr.n_z
-        rf = tr.rootfinder(TOLERANCE, MAX_ITER, error_on_fail=True)
-        pose, t = ca.MX.sym("pose", 3), ca.MX.sym("t")
-        fp, g = ca.MX.sym("fp", 6), ca.MX.sym("g", 2)
-        scale, tau_mu, z0 = ca.MX.sym("k"), ca.MX.sym("tau_mu"), ca.MX.sym("z0", tr.n_z)
-        base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t,
-                               grasper.x, grasper.tilt)
+    def __init__(self, tr, n_c: int):
+        self.tr = tr
+        nx = sum(SIZES.values())
+        x, z, c = ca.SX.sym("x", nx), ca.SX.sym("z", tr.n_z), ca.SX.sym("c", n_c)
+        parts = dict(zip(SIZES, ca.vertsplit(x, np.cumsum([0, *SIZES.values()]).tolist())))
+        pose, t, fp, g = parts["pose"], parts["t"], parts["fp"], parts["g"]
+        scale, tau_mu = parts["k"], parts["tau_mu"]
+        K = tr.beam.K
+        gx, tilt, eta, lam, gamma, ei_ref = (c[i] for i in range(N_FIXED))
+        widths, params = c[N_FIXED:N_FIXED + K], c[N_FIXED + K:]
+        base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
         centre = ca.vertcat(pose[0], 0.0, pose[1])
-        u0, B, _ = section((bird.eta, bird.lam, bird.gamma), (pose[0], 0.0, pose[1]), pose[2],
-                           base, R)
-        q = ca.vertcat(fp[5], self.ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], tau_mu, self.widths,
-                       stiffness.params)
-        z = rf(z0, q)
+        u0, B, _ = section((eta, lam, gamma), (pose[0], 0.0, pose[1]), pose[2], base, R)
+        q = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], tau_mu, widths, params)
         post = tr.post(z, q)[0]
         x_l, y_l, force, alpha = post[0], post[1], scale * post[3], post[4]
         pressing = ca.fmax(force, 0.0)
@@ -63,7 +90,85 @@ class FingerLoad:
         f_w = plane @ ca.vertcat(pressing * ca.cos(alpha), -pressing * ca.sin(alpha))
         r = base + plane @ ca.vertcat(x_l, y_l) - centre
         load = 2 * ca.vertcat(f_w[0], f_w[2], r[2] * f_w[0] - r[0] * f_w[2])
-        return ca.Function(f"finger_{gf.name}_{mode}", [pose, t, fp, g, scale, tau_mu, z0],
-                           [load, pressing, force, z],
-                           ["pose", "t", "fp", "g", "k", "tau_mu", "z0"],
-                           ["load", "force", "raw_force", "z"])
+        out = ca.vertcat(load, pressing)
+        name = tr.residual.name()
+        self.pre = ca.Function(f"{name}_q", [x, c], [q], ["x", "c"], ["q"])
+        self.loads = ca.Function(f"{name}_loads", [x, z, c], [load, pressing],
+                                 ["x", "z", "c"], ["load", "force"])
+        # the implicit-function blocks at a solution z: R_z, ∂R/∂x, ∂out/∂z, ∂out/∂x
+        res = tr.residual(z, q)
+        self.blocks = ca.Function(
+            f"{name}_blocks", [x, z, c],
+            [ca.jacobian(res, z), ca.jacobian(res, x), ca.jacobian(out, z), ca.jacobian(out, x)],
+            ["x", "z", "c"], ["R_z", "R_x", "out_z", "out_x"])
+        zq, qq = ca.SX.sym("z", tr.n_z), ca.SX.sym("q", tr.n_q)
+        rq = tr.residual(zq, qq)
+        jac_res = ca.Function(f"{name}_jac_z", [zq, qq], [ca.jacobian(rq, zq), rq])
+        done = compiled([self.pre, self.loads, self.blocks, jac_res])
+        self.pre, self.loads, self.blocks, jac_res = done.functions
+        #: whether the SX parts run compiled, and the compiler or why not
+        self.compiled, self.compile_reason = done.compiled, done.reason
+        self.rootfinder = ca.rootfinder(
+            f"{name}_newton_nlp", "newton", tr.residual,
+            {"abstol": TOLERANCE, "max_iter": MAX_ITER, "error_on_fail": True,
+             "line_search": True, "linear_solver": "qr", "show_eval_warnings": False,
+             "jacobian_function": jac_res})
+
+
+_STAGES: dict = {}
+
+
+def stage_functions(tr, n_c: int) -> StageFunctions:
+    key = (id(tr), n_c)
+    if key not in _STAGES:
+        _STAGES[key] = StageFunctions(tr, n_c)
+    return _STAGES[key]
+
+
+class FingerLoad:
+    """``functions[mode]`` for one finger (mode ``interior`` or ``tip``);
+    ``compiled[mode]``: (whether its SX parts run compiled, the compiler
+    command or why not)."""
+
+    def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
+                 intervals: int, degree: int = 4):
+        # the simulator's mesh and reference rigidity, so that its z are guesses here
+        reference = RobustContact(gf.finger, friction, intervals, degree)
+        self.ei_ref, self.widths = reference.ei_ref, reference.widths
+        self.n_z, self.transcriptions, self.compiled = {}, {}, {}
+        self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
+                                          bird.gamma, self.ei_ref], self.widths,
+                                         gf.finger.stiffness.params])
+        self.functions = {m: self._build(gf, intervals, degree, m) for m in MODES}
+
+    def _build(self, gf, intervals, degree, mode) -> ca.Function:
+        tr = contact_transcription(gf.finger.stiffness, intervals, degree, mode, ellipse="conic")
+        self.n_z[mode], self.transcriptions[mode] = tr.n_z, tr
+        st = stage_functions(tr, self.constants.size)
+        self.compiled[mode] = st.compiled, st.compile_reason
+        c = ca.DM(self.constants)
+        args = [ca.MX.sym(n, SIZES[n]) for n in SIZES]
+        z0 = ca.MX.sym("z0", tr.n_z)
+        x = ca.vertcat(*args)
+        z = st.rootfinder(z0, st.pre(x, c))
+        load, force = st.loads(x, z, c)
+        # the Jacobian at the solution, by the adjoint of the contact: inputs,
+        # then the nominal outputs (the solution z is the last)
+        x_j = [ca.MX.sym(n, SIZES[n]) for n in SIZES]
+        outs = [ca.MX.sym(f"out_{n}", s) for n, s in zip(OUTPUTS, (3, 1, tr.n_z))]
+        r_z, r_x, o_z, o_x = st.blocks(ca.vertcat(*x_j), outs[-1], c)
+        adjoint = ca.solve(r_z.T, o_z.T, "qr")
+        d_out = o_x - ca.mtimes(adjoint.T, r_x)
+        cuts = np.cumsum([0, *SIZES.values()]).tolist()
+        blocks = []
+        for row in ca.vertsplit(d_out, [0, 3, 4]):
+            blocks += ca.horzsplit(row, cuts) + [ca.MX(row.size1(), tr.n_z)]
+        # z is the contact's state, an output to read, not to differentiate
+        blocks += [ca.MX(tr.n_z, n) for n in [*SIZES.values(), tr.n_z]]
+        name = f"finger_{gf.name}_{mode}"
+        jac = ca.Function(f"jac_{name}", [*x_j, ca.MX.sym("z0", tr.n_z), *outs], blocks,
+                          [*INPUTS, *(f"out_{o}" for o in OUTPUTS)],
+                          [f"jac_{o}_{i}" for o in OUTPUTS for i in INPUTS])
+        return ca.Function(name, [*args, z0], [load, force, z], INPUTS, OUTPUTS,
+                           {"custom_jacobian": jac, "jac_penalty": 0,
+                            "is_diff_out": DIFFERENTIABLE})

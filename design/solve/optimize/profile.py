@@ -33,6 +33,12 @@ of solves is counted as finger stages x evaluations of nlp_g and nlp_jac_g
 (each evaluates every stage's rootfinder once; the Jacobian's derivatives
 reuse that solution).
 
+``compiled`` says whether the NLPs' finger functions ran as compiled C
+(design/solve/compiled.py) or interpreted, with the compiler command or the
+reason (no compiler, a failed build, ``DESIGN_COMPILE=0``), and how many
+libraries the run built (their compile time is inside NLP construction) or
+loaded from the cache.
+
 Peak memory is the process's peak resident set (``getrusage``'s
 ``ru_maxrss``) since it started, which includes whatever ran before the
 design run in the same process.
@@ -46,6 +52,8 @@ import sys
 import time
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+
+from design.solve.compiled import status as compile_status
 
 #: phase names in the order tables list them
 SETUP = "problem setup"
@@ -149,6 +157,10 @@ class Profile:
     phases: dict = field(default_factory=dict)
     #: group (OPTIMISER, VIEWS) -> NLPTotals
     nlps: dict = field(default_factory=dict)
+    #: compiled libraries loaded in this process before the run
+    libraries_before: int = field(default_factory=lambda: len(compile_status.libraries))
+    #: per NLP: (its finger functions run compiled, the compiler or why not)
+    compiled: list = field(default_factory=list)
 
     def add(self, phase: str, seconds: float, count: int = 1, cpu: float = 0.0) -> None:
         entry = self.phases.setdefault(phase, [0.0, 0, 0.0])
@@ -173,6 +185,8 @@ class Profile:
         None (the NLP was not built or not solved): nothing to add."""
         if not timings:
             return
+        if "compiled" in timings:
+            self.compiled.append(timings["compiled"])
         self.add(f"{group}: {CONSTRUCTION}", timings.get("build_s", 0.0), 0,
                  timings.get("build_cpu_s", 0.0))
         if "solve_s" in timings:
@@ -188,6 +202,16 @@ class Profile:
             self.add(name, wall, count, cpu)
         for group, totals in other.nlps.items():
             self.nlps.setdefault(group, NLPTotals()).merge(totals)
+        self.compiled += other.compiled
+
+    def compiled_summary(self) -> dict:
+        """Whether the NLPs' finger functions ran compiled (None: no NLP was
+        built), the compiler command or why not, and the libraries built or
+        loaded during the run."""
+        reasons = sorted({r for _, rs in self.compiled for r in rs})
+        return {"compiled": all(c for c, _ in self.compiled) if self.compiled else None,
+                "reason": "; ".join(reasons),
+                **compile_status.summary(self.libraries_before)}
 
     def summary(self) -> dict:
         """result.json's ``profile``: the phases in order with the unaccounted
@@ -205,6 +229,7 @@ class Profile:
         return {"wall_time_s": total, "cpu_time_s": total_cpu, "phases": phases,
                 "nlp": {group: totals.summary() for group, totals in self.nlps.items()},
                 "peak_memory_MiB": peak_memory_mib(),
+                "compiled": self.compiled_summary(),
                 "machine": {"cpus": self.cpus, "load_average_at_start": list(self.load_average),
                             # BLAS threads change the linear algebra's speed on 2 shared cores
                             "OPENBLAS_NUM_THREADS": os.environ.get("OPENBLAS_NUM_THREADS")}}
@@ -256,4 +281,9 @@ def profile_text(profile: dict) -> str:
     load = ", ".join(f"{x:.2f}" for x in m["load_average_at_start"])
     lines.append(f"peak memory {profile['peak_memory_MiB']:.0f} MiB; {m['cpus']} cores, load "
                  f"average {load} at the start")
+    c = profile.get("compiled")
+    if c and c["compiled"] is not None:
+        lines.append(f"contact functions {'compiled' if c['compiled'] else 'interpreted'} "
+                     f"({c['reason']}); {c['libraries_built']} of {c['libraries_loaded']} "
+                     f"libraries built in this run ({c['compile_wall_time_s']:.1f} s)")
     return "\n".join(lines)

@@ -135,6 +135,10 @@ class DesignNLP:
                                       setup.finger_friction, settings.beam_intervals,
                                       settings.degree) for i in sorted(used)}
         self._modes = {}
+        #: (whether every finger function's SX parts run compiled, the reasons)
+        states = [m for f in self.fingers.values() for m in f.compiled.values()]
+        self.compiled = (all(c for c, _ in states),
+                         sorted({reason for _, reason in states}))
         self.objective = objective
         self._build(run, cap, rules, box)
 
@@ -323,7 +327,8 @@ class DesignNLP:
         (s) of ``build`` (nlpsol with its derivative functions), ``solve``
         (the solver call) and ``post`` (reading the solution back) as
         ``build_s``, ``build_cpu_s`` and so on, CasADi's ``stats`` and the
-        number of ``finger_stages`` (design/solve/optimize/profile.py)."""
+        number of ``finger_stages`` and whether the finger functions run
+        ``compiled`` (design/solve/optimize/profile.py)."""
         s = self.settings
         history: list = []
         callback = _Progress(self, history, self.progress)
@@ -336,7 +341,7 @@ class DesignNLP:
                 "record_time": True,
                 # a rootfinder that fails at a trial point makes Ipopt shorten its step
                 "show_eval_warnings": False}
-        self.timings = {"finger_stages": int(self.force.numel())}
+        self.timings = {"finger_stages": int(self.force.numel()), "compiled": self.compiled}
         with self._timed("build"):
             solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
         try:

@@ -1,0 +1,166 @@
+"""Compiled CasADi functions (design/solve/compiled.py): the same outputs as
+the interpreted ones, a cache that builds once, the interpreted fallback
+when there is no compiler or it fails; and the optimiser's finger function
+(design/solve/optimize/finger_load.py), whose explicit Jacobian must equal
+CasADi's derivative of the rootfinder it replaces."""
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from design.solve import compiled as comp
+
+
+@pytest.fixture
+def cache(tmp_path, monkeypatch):
+    """An empty cache folder; the compiler settings of the environment unset."""
+    monkeypatch.setenv("DESIGN_CACHE_DIR", str(tmp_path))
+    for variable in ("DESIGN_COMPILE", "CC", "DESIGN_CFLAGS"):
+        monkeypatch.delenv(variable, raising=False)
+    return tmp_path
+
+
+def small_function(name="small"):
+    x, p = ca.SX.sym("x", 3), ca.SX.sym("p", 2)
+    y = ca.vertcat(ca.sin(x[0]) * ca.exp(p[0] * x[1]), ca.sqrt(1 + x[2] ** 2) / (2 + p[1]),
+                   ca.atan2(x[1], x[0] + 3) + ca.fmax(x[2], 0.1))
+    return ca.Function(name, [x, p], [y, ca.jacobian(y, x)], ["x", "p"], ["y", "J"])
+
+
+needs_compiler = pytest.mark.skipif(comp.compiler()[0] is None,
+                                    reason="no C compiler: the fallback is tested below")
+
+
+@needs_compiler
+def test_compiled_equals_interpreted_and_is_cached(cache):
+    f = small_function()
+    done = comp.compiled([f])
+    g, = done.functions
+    assert done.compiled and "External" in str(g) and "gcc" in done.reason
+    rng = np.random.default_rng(1)
+    for _ in range(20):
+        x, p = rng.normal(size=3), rng.normal(size=2)
+        for a, b in zip(f(x, p), g(x, p)):
+            a, b = np.asarray(a), np.asarray(b)
+            assert np.allclose(a, b, rtol=1e-12, atol=1e-300), (a, b)
+    start = len(comp.status.libraries) - 1
+    assert comp.status.libraries[-1]["built"]
+    assert len(list(cache.glob("*.so"))) == 1
+    # the second time (as in the next run) the library is loaded, not built
+    h, = comp.compiled([small_function()]).functions
+    assert not comp.status.libraries[-1]["built"]
+    assert np.array_equal(np.asarray(h([1, 2, 3], [0.1, 0.2])[0]),
+                          np.asarray(g([1, 2, 3], [0.1, 0.2])[0]))
+    # a different function is a different library
+    comp.compiled([small_function("other")])
+    assert comp.status.libraries[-1]["built"] and len(list(cache.glob("*.so"))) == 2
+    summary = comp.status.summary(start)
+    assert summary["libraries_loaded"] == 3 and summary["libraries_built"] == 2
+
+
+def test_missing_compiler_falls_back_to_interpreted(cache, monkeypatch):
+    monkeypatch.setenv("CC", "no-such-compiler-here")
+    f = small_function()
+    done = comp.compiled([f])
+    assert done.functions[0] is f
+    assert not done.compiled and "not found" in done.reason
+    assert not list(cache.glob("*.so"))
+
+
+def test_failing_compiler_and_switch_fall_back(cache, monkeypatch):
+    monkeypatch.setenv("CC", "false")            # a compiler that always fails
+    f = small_function()
+    done = comp.compiled([f])
+    assert done.functions[0] is f
+    assert not done.compiled and "compilation failed" in done.reason
+    monkeypatch.delenv("CC")
+    monkeypatch.setenv("DESIGN_COMPILE", "0")
+    done = comp.compiled([f])
+    assert done.functions[0] is f and "DESIGN_COMPILE=0" in done.reason
+
+
+def pressing_contact(setup, finger: int, t: float):
+    """A light interior contact of the setup's finger at time t: the bird
+    (level, centred under the finger's point at 0.8 of its length) raised
+    until that part of the finger is 1.5 % inside its cut, solved by the
+    simulator's contact solver in the finger's frame. Returns the finger
+    function's inputs (pose, t, fp, g, k, τµ, z0) and the force (N)."""
+    from design.physics.contact import FingerPose
+    from design.physics.ellipse import Ellipse
+    from design.physics.kinematics import finger_frame, section
+    from design.solve.contact.robust import RobustContact
+    from design.solve.optimize.variables import parameters_of
+
+    v, gf, bird = parameters_of(setup), setup.grasper.fingers[finger], setup.bird
+    key = f"fingers.{gf.design_name}."
+    fp = np.array([v[key + "angle"] + gf.phase, v[key + "height"], gf.mount.radius,
+                   v[key + "phi_x"], v[key + "phi_y"], v[key + "length"]])
+    g = np.array([v["spacing"], v["drum_speed"]])
+    base, R = (np.asarray(a, float) for a in finger_frame(*fp[:5], *g, t, setup.grasper.x,
+                                                          setup.grasper.tilt))
+    x_bird = float((base.ravel() + R[:, 0] * 0.8 * fp[5])[0])
+    s = np.linspace(0.3, 1.0, 300) * fp[5]
+
+    def cut(z_bird):
+        u0, B, _ = section((bird.eta, bird.lam, bird.gamma), (x_bird, 0.0, z_bird), 0.0,
+                           base.ravel(), R)
+        return np.asarray(u0, float).ravel(), np.asarray(B, float)
+
+    def deepest(z_bird):                        # the finger's lowest level (p-c)'B(p-c)
+        u0, B = cut(z_bird)
+        d = np.stack([s - u0[0], np.full_like(s, -u0[1])])
+        return np.min(np.einsum("in,ij,jn->n", d, B, d))
+
+    lo, hi = bird.gamma, bird.gamma + 0.1
+    assert deepest(lo) > 1 > deepest(hi)
+    for _ in range(40):
+        lo, hi = ((lo + hi) / 2, hi) if deepest((lo + hi) / 2) > 0.985 else (lo, (lo + hi) / 2)
+    u0, B = cut(lo)
+    eig, vec = np.linalg.eigh(B)
+    ellipse = Ellipse(1 / np.sqrt(eig[0]), 1 / np.sqrt(eig[1]), (u0[0], u0[1]),
+                      float(np.arctan2(vec[1, 0], vec[0, 0])))
+    sol = RobustContact(gf.finger, setup.finger_friction, 4).solve(FingerPose(0.0, 0.0),
+                                                                    ellipse, "push")
+    assert sol.contact and sol.converged and sol.extras["mode"] == "interior"
+    inputs = [np.array([x_bird, lo, 0.0]), t, fp, g, 1.0, sol.extras["friction_ratio"],
+              sol.extras["z"]]
+    return inputs, sol.force
+
+
+def test_finger_jacobian_is_the_rootfinders_derivative(monkeypatch):
+    """The finger function's explicit Jacobian (the adjoint of the contact at
+    its solution) against CasADi's derivative of the same chain through the
+    rootfinder (the optimiser's former finger function), at a light contact
+    of the short test grasp."""
+    monkeypatch.setenv("DESIGN_COMPILE", "0")     # the formula, not the compiler
+    from design.solve.optimize.finger_load import SIZES, FingerLoad, StageFunctions
+    from tests.design_cases import short_setup
+
+    setup = short_setup()
+    gf = setup.grasper.fingers[0]
+    fl = FingerLoad(gf, setup.grasper, setup.bird, setup.finger_friction, 4)
+    F = fl.functions["interior"]
+    inputs, force = pressing_contact(setup, 0, 0.5)
+    load, pressing, z = F(*inputs)
+    assert float(pressing) == pytest.approx(force, rel=1e-8) and force > 0.05
+    # the reference: the same chain, differentiated by CasADi through the rootfinder
+    st = StageFunctions(fl.transcriptions["interior"], fl.constants.size)
+    x = ca.MX.sym("x", sum(SIZES.values()))
+    z0 = ca.MX.sym("z0", fl.n_z["interior"])
+    c = ca.DM(fl.constants)
+    root = st.tr.rootfinder(1e-10, 30, True)(z0, st.pre(x, c))
+    out = ca.vertcat(*st.loads(x, root, c))
+    reference = ca.Function("reference", [x, z0], [out, ca.jacobian(out, x)])
+    x0 = ca.vertcat(*[ca.DM(v) for v in inputs[:len(SIZES)]])
+    ref_out, ref_jac = reference(x0, inputs[-1])
+    assert np.allclose(np.asarray(ref_out).ravel(),
+                       np.concatenate([np.asarray(load).ravel(), np.asarray(pressing).ravel()]), rtol=1e-12,
+                       atol=1e-14)
+    blocks = F.jacobian()(*inputs, load, pressing, z)
+    n_in = len(F.name_in())
+    ours = ca.vertcat(*[ca.horzcat(*blocks[o * n_in:o * n_in + len(SIZES)]) for o in (0, 1)])
+    scale = float(ca.mmax(ca.fabs(ref_jac)))
+    assert scale > 0
+    assert float(ca.mmax(ca.fabs(ca.densify(ours) - ref_jac))) <= 1e-9 * scale
+    # z is an output to read (the next guess), not differentiated
+    assert F.jacobian().sparsity_out(2 * n_in).nnz() == 0
