@@ -164,3 +164,51 @@ def test_finger_jacobian_is_the_rootfinders_derivative(monkeypatch):
     assert float(ca.mmax(ca.fabs(ca.densify(ours) - ref_jac))) <= 1e-9 * scale
     # z is an output to read (the next guess), not differentiated
     assert F.jacobian().sparsity_out(2 * n_in).nnz() == 0
+
+
+def test_finger_batch_is_the_stages_one_by_one(monkeypatch):
+    """A batch of stages (one call for the NLP) gives each stage's loads and
+    its block of the Jacobian as a call per stage does, and evaluating it
+    again at the same point (the Jacobian after the constraints) solves no
+    contact again."""
+    monkeypatch.setenv("DESIGN_COMPILE", "0")
+    from design.solve.optimize.finger_load import FingerLoad
+    from tests.design_cases import short_setup
+
+    setup = short_setup()
+    fl = FingerLoad(setup.grasper.fingers[0], setup.grasper, setup.bird,
+                    setup.finger_friction, 4)
+    F = fl.functions["interior"]
+    base, _ = pressing_contact(setup, 0, 0.5)
+    stages = []
+    for dz in (0.0, 2e-4, 4e-4):                 # the bird a little higher: pressing harder
+        inputs = list(base)
+        inputs[0] = base[0] + np.array([0.0, dz, 0.0])
+        stages.append(inputs)
+    B = fl.batch("interior", 3)
+    columns = [ca.horzcat(*[ca.DM(s[k]) for s in stages]) for k in range(len(base))]
+    load, force, z = B(*columns)
+    solved = fl.stage_solves
+    assert solved == 3
+    forces = []
+    for n, inputs in enumerate(stages):
+        one = F(*inputs)
+        assert np.array_equal(np.asarray(load[:, n]), np.asarray(one[0]))
+        assert np.array_equal(np.asarray(force[:, n]), np.asarray(one[1]))
+        forces.append(float(one[1]))
+    assert forces[0] < forces[1] < forces[2]
+    # the Jacobian: stage n's block is the stage's own Jacobian, nothing between stages
+    x = [ca.MX.sym(f"x{k}", *columns[k].shape) for k in range(len(base))]
+    out = B(*x)
+    jacobian = ca.Function("j", x, [ca.jacobian(ca.vertcat(ca.vec(out[0]), ca.vec(out[1])),
+                                                x[0])])(*columns)
+    assert fl.stage_solves == solved                    # the same point: remembered
+    J = np.asarray(ca.densify(jacobian))
+    for n, inputs in enumerate(stages):
+        own = F.jacobian()(*inputs, *F(*inputs))
+        rows = [3 * n, 3 * n + 1, 3 * n + 2, 9 + n]
+        expected = np.vstack([np.asarray(ca.densify(own[0])), np.asarray(ca.densify(own[7]))])
+        assert np.allclose(J[np.ix_(rows, range(3 * n, 3 * n + 3))], expected,
+                           rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+        others = [c for c in range(9) if c // 3 != n]
+        assert not np.any(J[np.ix_(rows, others)])

@@ -28,10 +28,11 @@ and of the iteration callback; what remains of the Ipopt phase is Ipopt's
 own work (linear algebra, L-BFGS, line search) and CasADi's overhead.
 The contact rootfinders embedded in the constraints have no statistics
 CasADi accumulates over a solve (a rootfinder's ``stats()`` describe its
-last call only), so their time is inside nlp_g and nlp_jac_g; their number
-of solves is counted as finger stages x evaluations of nlp_g and nlp_jac_g
-(each evaluates every stage's rootfinder once; the Jacobian's derivatives
-reuse that solution).
+last call only), so their time is inside nlp_g and nlp_jac_g; the NLP
+counts the stage contacts it solved (``rootfinder_solves``: an evaluation
+at a point already evaluated, as the Jacobian after the constraints,
+reuses the solutions; design/solve/optimize/finger_load.py), else they are
+counted as finger stages x evaluations of nlp_g and nlp_jac_g.
 
 ``compiled`` says whether the NLPs' finger functions ran as compiled C
 (design/solve/compiled.py) or interpreted, with the compiler command or the
@@ -115,8 +116,12 @@ class NLPTotals:
                     entry[0] += float(stats.get(f"t_wall_{name}", 0.0))
                     entry[1] += calls
                     entry[2] += float(stats.get(f"t_proc_{name}", 0.0))
-        evaluations = int(stats.get("n_call_nlp_g", 0)) + int(stats.get("n_call_nlp_jac_g", 0))
-        self.rootfinder_solves += int(timings.get("finger_stages", 0)) * evaluations
+        if "rootfinder_solves" in timings:
+            self.rootfinder_solves += int(timings["rootfinder_solves"])
+        else:                   # every evaluation of g or its Jacobian solves every stage
+            evaluations = int(stats.get("n_call_nlp_g", 0)) + \
+                int(stats.get("n_call_nlp_jac_g", 0))
+            self.rootfinder_solves += int(timings.get("finger_stages", 0)) * evaluations
 
     def merge(self, other: NLPTotals) -> None:
         self.solves += other.solves

@@ -154,24 +154,61 @@ class DesignNLP:
                                            [ca.vertcat(y[3:], acc), normal, friction])
         return self._modes[key]
 
-    def _stage(self, y, t, contacts, values, forces):
-        """Summed finger loads at one stage; appends each finger's force."""
-        total = ca.MX.zeros(3)
-        grasper = self.setup.grasper
+    def _runge_kutta(self, grid, values) -> dict:
+        """The RK4 stages of every interval: (j, k) -> (the summed finger
+        loads at each stage, the stage derivatives k_s, the finger forces in
+        stage then finger order). Built stage by stage across all intervals
+        (stage s needs stage s-1 of its own interval only), so that each
+        finger and contact mode is one batched call per stage
+        (FingerLoad.batch) instead of a call per interval."""
+        sch, grasper = self.schedule, self.setup.grasper
         g = ca.vertcat(values["spacing"], values["drum_speed"])
-        for i, c in enumerate(contacts):
-            if c is None:
-                continue
+        design = {}
+        for i in self.fingers:
             gf = grasper.fingers[i]
             key = f"fingers.{gf.design_name}."
-            fp = ca.vertcat(values[key + "angle"] + gf.phase, values[key + "height"],
-                            gf.mount.radius,
-                            values[key + "phi_x"], values[key + "phi_y"], values[key + "length"])
-            scale = values[f"groups.{gf.group}.stiffness_scale"]
-            out = self.fingers[i].functions[c.mode](y[:3], t, fp, g, scale, c.tau_mu, c.z)
-            total += out[0]
-            forces.append(out[1])
-        return total
+            design[i] = (ca.vertcat(values[key + "angle"] + gf.phase, values[key + "height"],
+                                    gf.mount.radius, values[key + "phi_x"],
+                                    values[key + "phi_y"], values[key + "length"]),
+                         values[f"groups.{gf.group}.stiffness_scale"])
+        cells = [(j, k) for j, phase in enumerate(sch.phases) for k in range(phase.intervals)]
+        out = {cell: ([], [], []) for cell in cells}
+        for s, c in enumerate(STAGES):
+            states, times, calls = {}, {}, {}
+            for j, k in cells:
+                nodes, h, t_phase = grid[j]
+                y, ks = nodes[:, k], out[j, k][1]
+                t = t_phase + k * h
+                times[j, k] = t + c * h
+                states[j, k] = y if s == 0 else y + c * h * ks[-1] if s < 3 else y + h * ks[-1]
+                for i, contact in enumerate(sch.phases[j].contacts[k][s]):
+                    if contact is not None:
+                        calls.setdefault((i, contact.mode), []).append((j, k, contact))
+            results = {}
+            for (i, mode), group in calls.items():
+                f = self.fingers[i].batch(mode, len(group))
+                fp, scale = design[i]
+                load, force, _ = f(ca.horzcat(*[states[j, k][:3] for j, k, _ in group]),
+                                   ca.horzcat(*[times[j, k] for j, k, _ in group]),
+                                   ca.repmat(fp, 1, len(group)), ca.repmat(g, 1, len(group)),
+                                   ca.repmat(scale, 1, len(group)),
+                                   ca.DM([[cc.tau_mu for _, _, cc in group]]),
+                                   ca.DM(np.column_stack([cc.z for _, _, cc in group])))
+                for n, (j, k, _) in enumerate(group):
+                    results[j, k, i] = load[:, n], force[0, n]
+            for j, k in cells:
+                phase = sch.phases[j]
+                total = ca.MX.zeros(3)
+                for i, contact in enumerate(phase.contacts[k][s]):
+                    if contact is not None:
+                        load, force = results[j, k, i]
+                        total += load
+                        out[j, k][2].append(force)
+                out[j, k][0].append(total)
+                _, v_dot, _ = self._belt(times[j, k], values)
+                mode_f = self._mode_function(phase.mode, phase.sign)
+                out[j, k][1].append(mode_f(states[j, k], total, v_dot)[0])
+        return out
 
     def _belt(self, t, values):
         c = self.setup.conveyor
@@ -210,7 +247,7 @@ class DesignNLP:
             constrain(values["conveyor.start_time"] - sch.t_start, 0.0, np.inf, "belt start")
         bird = self.setup.bird
         start_state = ca.vertcat(t0 + travel, bird.gamma, 0.0, v_a, 0.0, 0.0)
-        previous_end = None
+        grid = []                       # per phase: (nodes, interval h, start time)
         t_phase = sch.t_start
         for j, phase in enumerate(sch.phases):
             h = durations[j] / phase.intervals
@@ -228,6 +265,11 @@ class DesignNLP:
             lbw.append(np.tile([-np.inf, 0.0, -MAX_PITCH, -np.inf, -np.inf, -np.inf],
                                phase.intervals))
             ubw.append(np.tile([np.inf, 0.5, MAX_PITCH, np.inf, np.inf, np.inf], phase.intervals))
+            grid.append((nodes, h, t_phase))
+            t_phase = t_phase + durations[j]
+        stages = self._runge_kutta(grid, values)
+        previous_end = None
+        for j, (phase, (nodes, h, t_phase)) in enumerate(zip(sch.phases, grid)):
             mode_f = self._mode_function(phase.mode, phase.sign)
             first = nodes[:, 0]
             if previous_end is None:
@@ -240,16 +282,8 @@ class DesignNLP:
             for k in range(phase.intervals):
                 y = nodes[:, k]
                 t = t_phase + k * h
-                stage_loads, ks = [], []
-                state = y
-                for s, c in enumerate(STAGES):
-                    ts = t + c * h
-                    if s > 0:
-                        state = y + c * h * ks[-1] if s < 3 else y + h * ks[-1]
-                    q = self._stage(state, ts, phase.contacts[k][s], values, forces)
-                    stage_loads.append(q)
-                    _, v_dot, _ = self._belt(ts, values)
-                    ks.append(mode_f(state, q, v_dot)[0])
+                stage_loads, ks, stage_forces = stages[j, k]
+                forces += stage_forces
                 end = y + h / 6 * (ks[0] + 2 * ks[1] + 2 * ks[2] + ks[3])
                 # the mode holds at the node (its stage-1 loads)
                 _, v_dot, _ = self._belt(t, values)
@@ -273,7 +307,6 @@ class DesignNLP:
                     previous_end = end
                     if phase.end == "touch-down":
                         constrain(end[1] - dyn.support(end[2])[1], 0.0, 0.0, "touch-down")
-            t_phase = t_phase + durations[j]
         constrain(ca.sum1(durations), sch.t_end - sch.t_start, sch.t_end - sch.t_start, "horizon")
         self.force = ca.vertcat(*forces)
         if forces:
@@ -315,6 +348,11 @@ class DesignNLP:
         constrain(margin, 0.0 if phase.exact else -np.inf, 0.0, tag)
 
     @property
+    def stage_solves(self) -> int:
+        """Finger contacts solved so far in this NLP's functions."""
+        return sum(f.stage_solves for f in self.fingers.values())
+
+    @property
     def size(self) -> dict:
         return {"variables": int(self.x.numel()), "constraints": int(self.g.numel()),
                 "jacobian_nonzeros": int(ca.jacobian_sparsity(self.g, self.x).nnz()),
@@ -327,7 +365,8 @@ class DesignNLP:
         (s) of ``build`` (nlpsol with its derivative functions), ``solve``
         (the solver call) and ``post`` (reading the solution back) as
         ``build_s``, ``build_cpu_s`` and so on, CasADi's ``stats`` and the
-        number of ``finger_stages`` and whether the finger functions run
+        number of ``finger_stages``, the contacts solved during the solve
+        (``rootfinder_solves``) and whether the finger functions run
         ``compiled`` (design/solve/optimize/profile.py)."""
         s = self.settings
         history: list = []
@@ -344,6 +383,7 @@ class DesignNLP:
         self.timings = {"finger_stages": int(self.force.numel()), "compiled": self.compiled}
         with self._timed("build"):
             solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
+        solves = self.stage_solves
         try:
             with self._timed("solve"), _casadi_output_muted() as streams:
                 callback.streams = streams
@@ -351,6 +391,7 @@ class DesignNLP:
                              ubg=self.ubg)
         finally:
             self.timings["stats"] = _stats(solver)
+            self.timings["rootfinder_solves"] = self.stage_solves - solves
         with self._timed("post"):
             return self._result(sol, solver.stats(), self.timings["solve_s"], history, callback)
 
