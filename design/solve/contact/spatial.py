@@ -255,14 +255,21 @@ class SpatialContact:
                                               "pose", converged=False), None
         if segment_level(quadric, length) >= 0.0:
             return no_spatial_contact(length, "the straight finger misses the object"), None
-        if previous is not None:
-            # the usual case, a short step: geometry and friction in one Newton
-            direct = self._step(previous, quadric, friction)
-            if isinstance(direct, SpatialState):
-                sol = self._solution(direct, "", detail)
-                sol.extras["friction_held"] = 1.0
-                return sol, direct
-        # else the geometry first, under the friction it had; then the friction
+        # the usual case, a short step: geometry and friction in one Newton
+        state = self._step(previous, quadric, friction) if previous is not None else None
+        held, msg = 1.0, ""
+        if not isinstance(state, SpatialState):
+            state, held, msg = self._settle(quadric, friction, previous)
+            if state is None:
+                return no_spatial_contact(length, msg, converged=msg == GRAZES), None
+        sol = self._solution(state, msg, detail)
+        sol.extras["friction_held"] = held
+        return sol, state
+
+    def _settle(self, quadric: Quadric, friction: np.ndarray, previous: SpatialState | None):
+        """The geometry first, continued from ``previous`` under the friction
+        it had (else from first touch); then the friction. Returns (state or
+        None, the share of the friction change carried, message)."""
         if previous is not None:
             state, msg = self._continue(previous, quadric, previous.friction)
             if state is None and msg != BASE_REACHED:
@@ -272,14 +279,12 @@ class SpatialContact:
         else:
             state, msg = self._from_grazing(quadric, NO_FRICTION)
         if state is None:
-            return no_spatial_contact(length, msg, converged=msg == GRAZES), None
+            return None, 0.0, msg
         state, held = self._apply_friction(state, friction)
         if held < 1.0:
             msg = "; ".join(m for m in (msg, f"sticking: the finger carries {held:.0%} of the "
                                              f"sliding friction (no equilibrium beyond)") if m)
-        sol = self._solution(state, msg, detail)
-        sol.extras["friction_held"] = held
-        return sol, state
+        return state, held, msg
 
     def sliding_velocity(self, state: SpatialState, kin: Kinematics) -> np.ndarray:
         """The finger's material point at the contact relative to the object's
