@@ -10,7 +10,7 @@ from design.physics.ellipse import Ellipse
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
 from design.solve.contact import RobustContact
-from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact
+from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact, SpatialState
 from tests.problems import thesis_finger, uniform_finger
 
 #: semi-axis (m) along the finger frame's z of the ellipsoid built on a planar ellipse
@@ -137,6 +137,28 @@ def test_continued_and_fresh_solutions_agree():
         sol, state = solver.solve(quadric, np.zeros(3), state)
     fresh, _ = SpatialContact(thesis_finger()).solve(target)
     np.testing.assert_allclose(sol.force, fresh.force, atol=1e-8 * np.linalg.norm(fresh.force))
+
+
+def test_a_step_in_pose_and_friction_at_once_lands_where_the_continuation_does():
+    """Along a run each solve first tries one Newton step to the new pose and
+    the new friction law together; the fallback continues the geometry, then
+    the friction. Both reach the same equilibrium (1e-8 relative), under a
+    sliding Coulomb law whose rates change from step to step."""
+    target = ellipsoid_on(ELLIPSES["deep"], 0.5)
+    B = np.array([[0.0, -2.1, 0.3], [2.1, 0.0, -0.4], [-0.3, 0.4, 0.0]])
+
+    def law(k):
+        return FrictionLaw(mu=0.6, speed=0.02, sliding_at_origin=np.array([0.02, 0.1 * k, 0.03]),
+                           sliding_gradient=(1 + k) * B)
+
+    solver = SpatialContact(thesis_finger())
+    _, state = solver.solve(target.shifted(np.array([0.0, -0.003, 0.0])), law(0.0))
+    direct, _ = solver.solve(target, law(1.0), state)
+    assert isinstance(solver._step(state, target, law(1.0).params), SpatialState)  # taken
+    settled, held, _ = solver._settle(target, law(1.0).params, state)
+    assert held == 1.0 and direct.normal_force > 1.0
+    np.testing.assert_allclose(direct.force, -settled.post[10:13],
+                               atol=1e-8 * np.linalg.norm(direct.force))
 
 
 def test_no_contact_and_invalid_poses_are_told_apart():
