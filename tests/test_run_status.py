@@ -49,6 +49,11 @@ class NoBetterNLP:
         self.d = (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
         self.hold = run.summary["hold_time_s"]
 
+    def rebound(self, cap, box=None):
+        """The loop's NLP after a rejected candidate (DesignNLP.rebound)."""
+        self.d = (np.asarray(box[0], float) + np.asarray(box[1], float)) / 2
+        return self
+
     def solve(self):
         history = [{"iteration": 0, "hold_time_s": self.hold, "violation": 0.0}]
         return NLPResult(self.d, np.zeros(1), self.hold, 0.0, "Solve_Succeeded", True, 1,

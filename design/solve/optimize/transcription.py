@@ -92,6 +92,17 @@ IPOPT_ERRORS = frozenset({
     "Insufficient_Memory", "Internal_Error"})
 
 
+def _belt_function() -> ca.Function:
+    """belt_motion (design/physics/bird.py) as an SX function of (t, speed,
+    final speed, rate, start)."""
+    args = [ca.SX.sym(n) for n in ("t", "speed", "final_speed", "rate", "start")]
+    return ca.Function("belt", args, list(belt_motion(*args)),
+                       ["t", "speed", "final_speed", "rate", "start"], ["v", "v_dot", "travel"])
+
+
+_BELT = _belt_function()
+
+
 class NLPFailed(RuntimeError):
     """Ipopt ended on an error (one of :data:`IPOPT_ERRORS`): no iterate to use."""
 
@@ -211,9 +222,12 @@ class DesignNLP:
         return out
 
     def _belt(self, t, values):
+        """Belt speed, acceleration and travel at t: one call of an SX function
+        (the closed form's twenty-odd operations as one node of the NLP's
+        graph, not twenty: a third of the NLP's construction time)."""
         c = self.setup.conveyor
-        return belt_motion(t, c.speed, values["conveyor.final_speed"], values["conveyor.rate"],
-                           values["conveyor.start_time"])
+        return _BELT(t, c.speed, values["conveyor.final_speed"], values["conveyor.rate"],
+                     values["conveyor.start_time"])
 
     # ------------------------------------------------------------ NLP
     def _build(self, run, cap, rules, box):
@@ -319,6 +333,8 @@ class DesignNLP:
         self.g = ca.vertcat(*g)
         self.lbg, self.ubg = np.concatenate(lbg), np.concatenate(ubg)
         self.tags = tags
+        self._cap_rows = np.array([t == "cap" for t in tags], bool)
+        self._size, self._solver = None, None
         self.n_design, self.n_phases = n, len(sch.phases)
         if self.objective == "hold":
             self.f = -durations[sch.hold] / OBJECTIVE_SCALE
@@ -354,10 +370,23 @@ class DesignNLP:
 
     @property
     def size(self) -> dict:
-        return {"variables": int(self.x.numel()), "constraints": int(self.g.numel()),
+        if self._size is None:
+            self._size = {
+                "variables": int(self.x.numel()), "constraints": int(self.g.numel()),
                 "jacobian_nonzeros": int(ca.jacobian_sparsity(self.g, self.x).nnz()),
                 "design_variables": self.n_design, "phases": self.n_phases,
                 "intervals": self.schedule.intervals, "finger_stages": int(self.force.numel())}
+        return dict(self._size)
+
+    def rebound(self, cap: float, box=None) -> DesignNLP:
+        """The same NLP (schedule, graph, solver) with another cap (N) and
+        trust region ``box``: what the design loop needs after a rejected
+        candidate, whose schedule, the best design's, has not changed.
+        Solving it gives what a new NLP with these bounds gives."""
+        lo, hi = (np.zeros(self.n_design), np.ones(self.n_design)) if box is None else box
+        self.lbx[:self.n_design], self.ubx[:self.n_design] = lo, hi
+        self.ubg[self._cap_rows] = cap
+        return self
 
     def solve(self) -> NLPResult:
         """Ipopt from the simulated design's states. Records ``self.timings``
@@ -368,21 +397,14 @@ class DesignNLP:
         number of ``finger_stages``, the contacts solved during the solve
         (``rootfinder_solves``) and whether the finger functions run
         ``compiled`` (design/solve/optimize/profile.py)."""
-        s = self.settings
         history: list = []
-        callback = _Progress(self, history, self.progress)
-        opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
-                          "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0, "sb": "yes",
-                          "max_wall_time": s.max_wall_time,
-                          "mu_strategy": "adaptive", **s.ipopt},
-                "print_time": False, "iteration_callback": callback,
-                # each function's wall and CPU time and calls in stats(), for the run's profile
-                "record_time": True,
-                # a rootfinder that fails at a trial point makes Ipopt shorten its step
-                "show_eval_warnings": False}
         self.timings = {"finger_stages": int(self.force.numel()), "compiled": self.compiled}
         with self._timed("build"):
-            solver = ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
+            if self._solver is None:           # built once, solved again after rebound()
+                callback = _Progress(self, history, self.progress)
+                self._solver = callback, self._nlpsol(callback)
+            callback, solver = self._solver
+            callback.restart(history)
         solves = self.stage_solves
         try:
             with self._timed("solve"), _casadi_output_muted() as streams:
@@ -394,6 +416,19 @@ class DesignNLP:
             self.timings["rootfinder_solves"] = self.stage_solves - solves
         with self._timed("post"):
             return self._result(sol, solver.stats(), self.timings["solve_s"], history, callback)
+
+    def _nlpsol(self, callback) -> ca.Function:
+        s = self.settings
+        opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
+                          "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0, "sb": "yes",
+                          "max_wall_time": s.max_wall_time,
+                          "mu_strategy": "adaptive", **s.ipopt},
+                "print_time": False, "iteration_callback": callback,
+                # each function's wall and CPU time and calls in stats(), for the run's profile
+                "record_time": True,
+                # a rootfinder that fails at a trial point makes Ipopt shorten its step
+                "show_eval_warnings": False}
+        return ca.nlpsol("design", "ipopt", {"x": self.x, "f": self.f, "g": self.g}, opts)
 
     @contextmanager
     def _timed(self, step: str):
@@ -500,6 +535,10 @@ class _Progress(ca.Callback):
         #: an exception in the callback, which ends the solve as an error
         self.error: Exception | None = None
         self.construct("progress", {})
+
+    def restart(self, history: list) -> None:
+        """For a new solve: record into ``history``, no error yet."""
+        self.history, self.error = history, None
 
     def get_n_in(self):
         return ca.nlpsol_n_out()

@@ -27,6 +27,10 @@ hold time within 2 %. That number is the optimiser's claim for the design;
 an independent simulation at a 4x finer resolution must confirm it (hold
 time within 2 %, peak force within 1 % over the cap) for the run to pass.
 
+After a rejected candidate the next NLP is the last one with the new cap
+and trust region (its schedule is the best design's, unchanged), not a new
+build.
+
 The loop times itself (``Outcome.profile``: simulations, each NLP's
 construction, Ipopt and CasADi's function statistics, the fixed-design
 views; design/solve/optimize/profile.py) without changing what it computes.
@@ -171,6 +175,20 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
         best = baseline
     out = Outcome(best, baseline, cap, profile=profile)
     radius, backed_off = settings.radius, cap
+    # the last NLP and the run whose schedule it was built on: after a rejected
+    # candidate the best design, hence the schedule, is the same, and only the
+    # cap and the trust region change (DesignNLP.rebound; the same solution
+    # as a new NLP's, without building the graph and the solver again)
+    built: dict = {}
+
+    def nlp_for(cap_nlp, box):
+        if built.get("run") is best.run:
+            return built["nlp"].rebound(cap_nlp, box)
+        nlp = DesignNLP(space, schedule_of(best.run, settings.nlp.time_step), best.run, cap_nlp,
+                        settings.nlp, rules, box, progress)
+        built.update(run=best.run, nlp=nlp)
+        return nlp
+
     say(f"baseline: hold {baseline.hold:.4f} s, peak finger force {baseline.peak:.2f} N "
         f"(cap {cap:.2f} N)")
     for it in range(settings.outer_iterations):
@@ -179,9 +197,7 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
         hi = np.clip(best.d + radius, 0, 1)
         say(f"outer iteration {it + 1}: trust region {radius:.3f}, NLP cap {cap_nlp:.2f} N")
         try:
-            result = build_and_solve(profile, OPTIMISER, lambda: DesignNLP(
-                space, schedule_of(best.run, settings.nlp.time_step), best.run, cap_nlp,
-                settings.nlp, rules, (lo, hi), progress))
+            result = build_and_solve(profile, OPTIMISER, lambda: nlp_for(cap_nlp, (lo, hi)))
         except (RuntimeError, ValueError) as exc:
             out.iterations.append({"iteration": it + 1, "radius": radius, "error": str(exc)})
             say(f"outer iteration {it + 1}: NLP failed ({exc}); shrinking the trust region")
