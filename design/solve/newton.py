@@ -103,18 +103,26 @@ class NewtonCache:
     """CasADi rootfinders (z0, q) -> z of one residual R(z, q) = 0, built once
     per (tolerance, max_iter, error_on_fail): Newton with line search;
     ``error_on_fail`` raises instead of returning the last iterate (inside an
-    NLP, where Ipopt then shortens its step)."""
+    NLP, where Ipopt then shortens its step). ``jacobian``: a function
+    making (z, q) -> (∂R/∂z, R), to use at every Newton step instead of
+    CasADi's own (e.g. a compiled one, design/solve/compiled.py: the same
+    operations, so the same iterates), made when the first rootfinder is."""
 
-    def __init__(self, name: str, residual: ca.Function, linear_solver: str):
+    def __init__(self, name: str, residual: ca.Function, linear_solver: str,
+                 jacobian: Callable[[], ca.Function] | None = None):
         self.name, self.residual, self.linear_solver = name, residual, linear_solver
+        self._make_jacobian, self._jacobian = jacobian, None
         self._built: dict = {}
 
     def get(self, tolerance: float, max_iter: int, error_on_fail: bool) -> ca.Function:
         key = (tolerance, max_iter, error_on_fail)
         if key not in self._built:
-            self._built[key] = ca.rootfinder(
-                self.name, "newton", self.residual,
-                {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
-                 "line_search": True, "linear_solver": self.linear_solver,
-                 "show_eval_warnings": False})
+            opts = {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
+                    "line_search": True, "linear_solver": self.linear_solver,
+                    "show_eval_warnings": False}
+            if self._make_jacobian is not None:
+                if self._jacobian is None:
+                    self._jacobian = self._make_jacobian()
+                opts["jacobian_function"] = self._jacobian
+            self._built[key] = ca.rootfinder(self.name, "newton", self.residual, opts)
         return self._built[key]

@@ -36,6 +36,7 @@ from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, le
                                     level_conic)
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import BeamTranscription, transcription
+from design.solve.compiled import compiled
 from design.solve.newton import NewtonCache
 
 MODES = ("interior", "tip")
@@ -60,7 +61,7 @@ class ContactTranscription:
 
     def __init__(self, stiffness: Stiffness, intervals: int, degree: int, mode: str,
                  ellipse: str = "axes"):
-        self.mode = mode
+        self.mode, self.ellipse = mode, ellipse
         level, gradient = ELLIPSE_FORMS[ellipse]
         self.beam = beam = transcription(stiffness, intervals, degree)
         K, nw = beam.K, beam.n_w
@@ -110,7 +111,18 @@ class ContactTranscription:
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
             [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
-        self._newton = NewtonCache(f"contact_{self.mode}_newton", self.residual, "qr")
+        self._newton = NewtonCache(f"contact_{self.mode}_newton", self.residual, "qr",
+                                   self._compiled_jacobian)
+
+    def _compiled_jacobian(self) -> ca.Function:
+        """(z, q) -> (∂R/∂z, R) for the Newton steps, compiled when a compiler
+        is there (design/solve/compiled.py; the same operations as CasADi's
+        own, so the same iterates to the last bit)."""
+        z, q = ca.SX.sym("z", self.n_z), ca.SX.sym("q", self.n_q)
+        r = self.residual(z, q)
+        jac = ca.Function(f"{self.residual.name()}_{self.ellipse}_jac_z", [z, q],
+                          [ca.jacobian(r, z), r])
+        return compiled([jac]).functions[0]
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40,
                    error_on_fail: bool = False) -> ca.Function:
