@@ -45,7 +45,8 @@ profile (wall time per phase, each CasADi function's evaluation time and
 calls, Ipopt's own time, peak memory: design/solve/optimize/profile.py)
 printed as a table and written to solve.json's ``main_job``, with its
 status, verified and optimiser hold, and the machine's cores and load at
-the start and end. About 4-5 minutes on 2 cores, on top of the sizes' 2.5.
+the start and end. About 1.5 minutes on 2 cores (4-5 before the compiled
+contact functions of issue 13), on top of the sizes' 2.5.
 
     python -m benchmarks.solve                  # sizes, then the main job's profile
     python -m benchmarks.solve --profile-only   # the main job's profile only
