@@ -58,6 +58,18 @@ def test_compiled_equals_interpreted_and_is_cached(cache):
     assert summary["libraries_loaded"] == 3 and summary["libraries_built"] == 2
 
 
+@needs_compiler
+def test_a_broken_cached_library_is_built_again(cache):
+    f = small_function("broken")
+    comp.compiled([f])
+    library, = cache.glob("*.so")
+    library.write_bytes(b"not a library")
+    done = comp.compiled([small_function("broken")])
+    assert done.compiled and comp.status.libraries[-1]["built"]
+    assert np.allclose(np.asarray(done.functions[0]([1, 2, 3], [0.1, 0.2])[0]),
+                       np.asarray(f([1, 2, 3], [0.1, 0.2])[0]), rtol=1e-12)
+
+
 def test_missing_compiler_falls_back_to_interpreted(cache, monkeypatch):
     monkeypatch.setenv("CC", "no-such-compiler-here")
     f = small_function()

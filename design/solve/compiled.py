@@ -106,10 +106,18 @@ def compiled(functions: list[ca.Function]) -> Compiled:
     command, reason = compiler()
     if command is None:
         return Compiled(list(functions), False, reason)
+    errors = (OSError, RuntimeError, subprocess.SubprocessError)
     try:
         path, built, seconds = _library(functions, command)
-        out = [ca.external(f.name(), str(path)) for f in functions]
-    except (OSError, RuntimeError, subprocess.SubprocessError) as exc:
+        try:
+            out = [ca.external(f.name(), str(path)) for f in functions]
+        except errors:
+            if built:
+                raise
+            path.unlink(missing_ok=True)        # a cached library that does not load: again
+            path, built, seconds = _library(functions, command)
+            out = [ca.external(f.name(), str(path)) for f in functions]
+    except errors as exc:
         return Compiled(list(functions), False,
                         f"compilation failed: {str(exc).strip()[:300]}")
     status.libraries.append({"path": str(path), "built": built, "compile_s": seconds,
