@@ -57,11 +57,14 @@ class CompileLog:
 
     def summary(self, since: int = 0) -> dict:
         """The libraries loaded since the ``since``-th, those built among
-        them and the wall time building took (s), and the cache folder."""
+        them, the wall time building took and the compiler's CPU time (s; in
+        child processes, so not in the run's own CPU time), and the cache
+        folder."""
         new = self.libraries[since:]
         return {"libraries_loaded": len(new),
                 "libraries_built": sum(1 for lib in new if lib["built"]),
                 "compile_wall_time_s": sum(lib["compile_s"] for lib in new),
+                "compiler_cpu_time_s": sum(lib["compile_cpu_s"] for lib in new),
                 "cache": str(cache_dir())}
 
 
@@ -120,21 +123,23 @@ def compiled(functions: list[ca.Function]) -> Compiled:
     except errors as exc:
         return Compiled(list(functions), False,
                         f"compilation failed: {str(exc).strip()[:300]}")
-    status.libraries.append({"path": str(path), "built": built, "compile_s": seconds,
+    status.libraries.append({"path": str(path), "built": built, "compile_s": seconds[0],
+                             "compile_cpu_s": seconds[1],
                              "functions": [f.name() for f in functions]})
     return Compiled(out, True, " ".join(command))
 
 
-def _library(functions: list[ca.Function], command: list[str]) -> tuple[Path, bool, float]:
+def _library(functions: list[ca.Function], command: list[str]
+             ) -> tuple[Path, bool, tuple[float, float]]:
     """The cached library's path, whether it was built now, and the wall
-    time (s) building it took."""
+    time and the compiler's CPU time (s) building it took."""
     key = library_key(functions, command)
     folder = cache_dir()
     path = folder / f"casadi_{key}.so"
     if path.exists():
-        return path, False, 0.0
+        return path, False, (0.0, 0.0)
     folder.mkdir(parents=True, exist_ok=True)
-    t0 = time.perf_counter()
+    t0, children = time.perf_counter(), _children_cpu()
     with tempfile.TemporaryDirectory(dir=folder, prefix="build_") as tmp:
         name = f"casadi_{key}"
         gen = ca.CodeGenerator(f"{name}.c", {"with_header": False})
@@ -148,4 +153,11 @@ def _library(functions: list[ca.Function], command: list[str]) -> tuple[Path, bo
             raise RuntimeError(f"{command[0]} exited with {done.returncode}: {done.stderr}")
         # atomic: a concurrent process either sees no library or a whole one
         os.replace(target, path)
-    return path, True, time.perf_counter() - t0
+    return path, True, (time.perf_counter() - t0, _children_cpu() - children)
+
+
+def _children_cpu() -> float:
+    """CPU time (s) of this process's finished child processes (the compiler:
+    not in the process's own process_time)."""
+    t = os.times()
+    return t.children_user + t.children_system

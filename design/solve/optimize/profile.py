@@ -37,8 +37,9 @@ counted as finger stages x evaluations of nlp_g and nlp_jac_g.
 ``compiled`` says whether the NLPs' finger functions ran as compiled C
 (design/solve/compiled.py) or interpreted, with the compiler command or the
 reason (no compiler, a failed build, ``DESIGN_COMPILE=0``), and how many
-libraries the run built (their compile time is inside NLP construction) or
-loaded from the cache.
+libraries the run built (their wall time is inside NLP construction; the
+compiler's CPU time, in child processes, is reported apart, not in the
+run's CPU time) or loaded from the cache.
 
 Peak memory is the process's peak resident set (``getrusage``'s
 ``ru_maxrss``) since it started, which includes whatever ran before the
@@ -290,5 +291,6 @@ def profile_text(profile: dict) -> str:
     if c and c["compiled"] is not None:
         lines.append(f"contact functions {'compiled' if c['compiled'] else 'interpreted'} "
                      f"({c['reason']}); {c['libraries_built']} of {c['libraries_loaded']} "
-                     f"libraries built in this run ({c['compile_wall_time_s']:.1f} s)")
+                     f"libraries built in this run ({c['compile_wall_time_s']:.1f} s wall, "
+                     f"{c.get('compiler_cpu_time_s', 0.0):.1f} s CPU in the compiler)")
     return "\n".join(lines)
