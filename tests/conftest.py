@@ -24,3 +24,57 @@ for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
 if "numpy" in sys.modules:
     warnings.warn("numpy was imported before tests/conftest.py set one BLAS thread; "
                   "set OPENBLAS_NUM_THREADS=1 in the environment for the full speed")
+
+
+def pytest_collection_finish(session):
+    """Start the prefetch worker (tests/prefetch.py) on the simulations and
+    references the selected tests will ask for, in the order they will."""
+    from tests import prefetch
+    if not prefetch.enabled() or len(session.items) < 2:
+        return
+    try:
+        prefetch.start(_prefetch_jobs(session))
+    except Exception as exc:                 # noqa: BLE001  the tests compute it all themselves
+        warnings.warn(f"no prefetch worker: {exc!r}")
+
+
+def _prefetch_jobs(session) -> list:
+    """(key, function, arguments, needs) of what the selected tests will ask
+    for, roughly in the order they will (the tests take over what the worker
+    has not reached); what none of them asks for is left out."""
+    from tests.design_cases import prefetch_jobs, prefetched_simulation
+    from tests.test_contact_poses import REFERENCES, imposed_side_references
+    from tests.test_design_solve import SETTINGS
+    from tests.test_reports import DESIGN_RUN, solve_short_design
+    from tests.test_reproduce_command import QUICK, reproduce_quick
+    from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
+
+    def asked(users: list[str]) -> bool:
+        return any(item.nodeid.startswith(tuple(users)) for item in session.items)
+
+    def fixture_used(name: str) -> bool:
+        return any(name in getattr(item, "fixturenames", ()) for item in session.items)
+
+    folder = session.config._tmp_path_factory.mktemp
+    jobs = []
+    if asked(["tests/test_contact_poses.py::test_imposed_side_matches"]):
+        jobs.append((REFERENCES, imposed_side_references, (), ()))
+    simulations = prefetch_jobs(SETTINGS)
+    jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
+             if asked(users)]
+    if fixture_used("design_run"):
+        # after the loop's and the verification's baseline runs, which it uses
+        jobs.append((DESIGN_RUN, solve_short_design, (folder("design"),),
+                     tuple(key for key, _, _ in simulations[:2])))
+    if fixture_used("quick"):
+        jobs.append((QUICK, reproduce_quick, (folder("reproduction"),), ()))
+    if fixture_used("beam"):
+        jobs.append((BEAM_STUDY, beam_study, (folder("tradeoff") / "out",), ()))
+    if asked(["tests/test_tradeoff.py::test_grasp_window_keeps"]):
+        jobs.append((GRASP_WINDOW, grasp_window_study, (), ()))
+    return jobs
+
+
+def pytest_sessionfinish(session):
+    from tests import prefetch
+    prefetch.stop()

@@ -8,7 +8,9 @@ and bird advanced so that nothing touches before), 0.85 s long; the hold is
 Its simulations are most of the test suite's time (5-15 s each), and
 several tests need the very same run, some through ``design simulate`` or
 ``design solve``; :func:`sharing_simulations` computes each distinct one
-once per session."""
+once per session, and those known before the first test starts
+(:func:`prefetch_jobs`) are computed ahead on the machine's other core
+(tests/prefetch.py)."""
 
 from __future__ import annotations
 
@@ -29,6 +31,7 @@ from design.reproduce.grasp import advanced, load_model, thesis_setup
 from design.solve.grasp import simulation
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
+from tests import prefetch
 
 GRASPER = Path(__file__).parent / "data" / "one_set_grasper.yaml"
 
@@ -99,9 +102,70 @@ def shared_simulate_grasp(setup, integrator: IntegratorSettings = IntegratorSett
         return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress)
     key = _inputs(setup, integrator, contact_nodes, reach_filter)
     if key not in _RUNS:
-        _RUNS[key] = simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter,
-                                               progress)
+        # computed ahead by the prefetch worker if it was given these inputs
+        _RUNS[key] = prefetch.result(key, _simulate, setup, integrator, contact_nodes,
+                                     reach_filter, progress)
     return replace(_RUNS[key], setup=setup)
+
+
+def _simulate(setup, integrator, contact_nodes, reach_filter, progress=None):
+    return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress)
+
+
+def prefetched_simulation(setup, integrator, contact_nodes, reach_filter):
+    """The prefetch worker's job: the run, also kept in the worker's own
+    cache, where its later jobs (the short design solve) find it."""
+    return shared_simulate_grasp(setup, integrator, contact_nodes, reach_filter)
+
+
+class _Asked(Exception):
+    pass
+
+
+def asked(call) -> tuple:
+    """The inputs (setup, integrator, contact nodes, reach filter) of the first
+    simulation that ``call()`` asks the design loop's simulator for; nothing
+    is simulated. So the prefetched inputs are the tests' own, settings such
+    as the verification's resolution included."""
+    def stop(setup, integrator=IntegratorSettings(), contact_nodes=6, reach_filter=True,
+             progress=None):
+        raise _Asked(setup, integrator, contact_nodes, reach_filter)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr("design.solve.optimize.trust_region.simulate_grasp", stop)
+        try:
+            call()
+        except _Asked as found:
+            return found.args
+    raise RuntimeError("no simulation asked for")
+
+
+def prefetch_jobs(settings) -> list[tuple[str, tuple, list[str]]]:
+    """The shared simulations the default run needs, as (key, inputs, the
+    tests that ask for them): the short grasp's baseline at the loop's
+    tolerance, its baseline and stiff lower fingers (scale 2) at the
+    verification's 4x finer resolution, the stiff design at the loop's, and
+    the baseline at the scenes' default tolerance. ``settings``: the
+    optimiser tests' LoopSettings (their time step sets the verification's)."""
+    from design.solve.optimize.trust_region import simulate, verify
+    space = stiffness_space("lower", hi=2.0)
+    base = space.scale(space.base_values)
+    design = ["tests/test_design_solve.py::test_verification_catches_a_design_over_the_cap",
+              "tests/test_design_solve.py::test_a_failed_verification_exits_1_and_says_so"]
+    design_report = ["tests/test_reports.py::test_design_report"]
+    both = stiffness_space("lower", "upper")
+    runs = [
+        (asked(lambda: simulate(both, both.scale(both.base_values), settings)),
+         ["tests/test_design_solve.py::test_kkt_conditions_hold_by_finite_differences",
+          design[1], "tests/test_reports.py::test_grasp_report", *design_report,
+          "tests/test_profile.py::"]),
+        (asked(lambda: verify(space, base, settings)), [*design, *design_report]),
+        (asked(lambda: verify(space, [1.0], settings)), design),
+        (asked(lambda: simulate(space, [1.0], settings)), design[1:]),
+        ((short_setup(), IntegratorSettings(), 6, True),
+         ["tests/test_interrupt.py::test_ctrl_c_stops_design_solve_in_ipopt",
+          "tests/test_run_status.py::"]),
+    ]
+    return [(_inputs(*inputs), inputs, users) for inputs, users in runs]
 
 
 @contextlib.contextmanager

@@ -14,6 +14,7 @@ from design.physics.contact import SIDES
 from design.physics.ellipse import Ellipse
 from design.solve.contact import RobustContact
 from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED
+from tests import prefetch
 from tests.contact_reference import reference
 from tests.problems import entering_poses, thesis_finger
 
@@ -25,12 +26,27 @@ FINGER = thesis_finger()
 #: below), and to 4e-12 m on the finger bent 140° by 396 N; 1e-7 leaves a
 #: wide margin
 REFERENCE_ERROR = 1e-7
+#: the prefetch key of :func:`imposed_side_references`
+REFERENCES = "tests/test_contact_poses.py: imposed-side references"
 
 
 def base_distance(pose, ell) -> float:
     """Least distance from the finger's base to the object (m)."""
     e = pose.view(ell)
     return float(np.min(np.hypot(*e.point(np.linspace(0.0, 2 * np.pi, 3601)))))
+
+
+def imposed_side(i: int) -> tuple[float, str]:
+    """Pose i's friction and imposed side: µ alternating, push and pull in pairs."""
+    return (0.0, 0.4)[i % 2], ("push", "pull")[(i // 2) % 2]
+
+
+def imposed_side_references() -> list:
+    """The independent reference of every pose on its imposed side (None
+    where that side has no equilibrium): 13 s, computed ahead in the
+    session's prefetch worker (tests/prefetch.py) when it runs."""
+    return [reference(FINGER, pose.view(ell), imposed_side(i)[0], SIDES[imposed_side(i)[1]])
+            for i, (pose, ell) in enumerate(POSES)]
 
 
 @pytest.fixture(scope="module")
@@ -51,11 +67,12 @@ def test_imposed_side_matches_the_least_energy_reference(solvers):
     through 140° around the object's end). Distinct equilibria of one pose lie
     centimetres apart. Where the reference finds no equilibrium on the
     imposed side, the solver must say so and name the side that has one."""
+    references = prefetch.result(REFERENCES, imposed_side_references)
     for i, (pose, ell) in enumerate(POSES):
-        mu, sliding = (0.0, 0.4)[i % 2], ("push", "pull")[(i // 2) % 2]
+        mu, sliding = imposed_side(i)
         coarse, fine = solvers[mu]
         sol = coarse.solve(pose, ell, sliding)
-        ref = reference(FINGER, pose.view(ell), mu, SIDES[sliding])
+        ref = references[i]
         where = f"pose {i} (µ = {mu}, {sliding}): {sol.message}"
         if ref is None:
             assert not sol.converged and "other side" in sol.message, where

@@ -23,6 +23,7 @@ from design.run import RunOutput
 from design.solve.contact.spatial import Quadric, SpatialContact
 from design.solve.grasp.fingers import FingerState
 from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from tests import prefetch
 from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
@@ -149,11 +150,14 @@ def test_grasp_report(tmp_path):
     assert rows["finger with the peak"] == s["max_finger_force_finger"]
 
 
-@pytest.fixture(scope="module")
-def design_run(tmp_path_factory):
-    """One short design solve (one outer iteration) written with its report;
-    its simulations shared with the other tests' (tests/design_cases.py)."""
-    tmp = tmp_path_factory.mktemp("design")
+#: the prefetch key of :func:`solve_short_design`
+DESIGN_RUN = "tests/test_reports.py: the short design solve"
+
+
+def solve_short_design(tmp: Path) -> int:
+    """One short design solve (one outer iteration) written with its report
+    to tmp/out; its exit status. Its simulations are shared with the other
+    tests' (tests/design_cases.py)."""
     problem = {"kind": "design", "name": "short_design", "description": "A short test.",
                "scene": str(short_scene(tmp)), "cap": "baseline",
                "variables": {"groups.upper.stiffness_scale": [0.5, 1.5]},
@@ -161,8 +165,17 @@ def design_run(tmp_path_factory):
     path = tmp / "problem.yaml"
     path.write_text(json.dumps(problem))
     with sharing_simulations():
-        status = main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
-    return status, tmp / "out"
+        return main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
+
+
+@pytest.fixture(scope="module")
+def design_run(tmp_path_factory):
+    """:func:`solve_short_design`'s status and output folder: run ahead by the
+    session's prefetch worker (tests/prefetch.py) into the folder it was
+    given, or here."""
+    given = prefetch.scheduled(DESIGN_RUN)
+    tmp = given[0] if given else tmp_path_factory.mktemp("design")
+    return prefetch.result(DESIGN_RUN, solve_short_design, tmp), tmp / "out"
 
 
 def test_design_report_has_every_section_and_matches_result(design_run):

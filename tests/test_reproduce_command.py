@@ -20,6 +20,7 @@ from design.report.page import number
 from design.reproduce.contact import CASES, THESIS_PASS, UNIFORM, pass_position, scene
 from design.reproduce.contact_rows import FEM_REL, FORCE_REL, POINT_TOL
 from design.reproduce.rows import BASES, COLUMNS, claim, compare
+from tests import prefetch
 from tests.closed_forms import EFFECTIVE_EI_REL, effective_ei, transverse_cantilever
 from tests.contact_reference import reference
 from tests.problems import thesis_finger
@@ -34,16 +35,27 @@ SECTIONS = ["summary", "beam", "effective-ei", "contact-cases", "contact-pass", 
 FIGURES = ["beam_shapes", "effective_ei", "contact_pass_force"]
 
 
-@pytest.fixture(scope="module")
-def quick(tmp_path_factory):
-    """One `design reproduce --quick` run as a user starts it: (folder, process)."""
-    out = tmp_path_factory.mktemp("reproduction")
+#: the prefetch key of :func:`reproduce_quick`
+QUICK = "tests/test_reproduce_command.py: design reproduce --quick"
+
+
+def reproduce_quick(out: Path) -> subprocess.CompletedProcess:
+    """`design reproduce --quick --out out` as a user starts it."""
     exe = Path(sys.executable).with_name("design")
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "design"]
     # thousands of tiny solves: on a busy machine BLAS threads only contend
     env = {**os.environ, "OPENBLAS_NUM_THREADS": "1"}
-    done = subprocess.run([*cmd, "reproduce", "--quick", "--out", str(out)], capture_output=True,
+    return subprocess.run([*cmd, "reproduce", "--quick", "--out", str(out)], capture_output=True,
                           text=True, env=env, timeout=300)
+
+
+@pytest.fixture(scope="module")
+def quick(tmp_path_factory):
+    """One `design reproduce --quick` run: (folder, process); started ahead by
+    the session's prefetch worker (tests/prefetch.py) when it runs."""
+    given = prefetch.scheduled(QUICK)
+    out = given[0] if given else tmp_path_factory.mktemp("reproduction")
+    done = prefetch.result(QUICK, reproduce_quick, out)
     assert done.returncode == 0, done.stderr
     return out, done
 

@@ -23,6 +23,7 @@ from design.run.grasp import setup_of
 from design.solve.beam import solve_beam
 from design.tradeoff.grasp import DEFAULT, shifted, simulate, window
 from design.tradeoff.study import Row, choose, mark_front, relative
+from tests import prefetch
 
 ROOT = Path(__file__).resolve().parents[1]
 BEAM = ROOT / "problems" / "beam_table_2_3.yaml"
@@ -30,15 +31,29 @@ BEAM = ROOT / "problems" / "beam_table_2_3.yaml"
 TOLERANCE = 1e-6
 
 
-@pytest.fixture(scope="module")
-def beam(tmp_path_factory):
-    """One quick study of Table 2-3: exit code, output folder, tradeoff.json, stdout."""
-    out = tmp_path_factory.mktemp("tradeoff") / "out"
+#: the prefetch keys of :func:`beam_study` and :func:`grasp_window_study`
+BEAM_STUDY = "tests/test_tradeoff.py: the quick study of Table 2-3"
+GRASP_WINDOW = "tests/test_tradeoff.py: the grasp window's runs"
+
+
+def beam_study(out: Path) -> tuple[int, str]:
+    """The quick study of Table 2-3 into ``out``: exit code, stdout."""
     stdout = io.StringIO()
     with contextlib.redirect_stdout(stdout):
         code = main(["tradeoff", str(BEAM), "--quick", "--tolerance", str(TOLERANCE),
                      "--out", str(out), "--quiet"])
-    return code, out, json.loads((out / "tradeoff.json").read_text()), stdout.getvalue()
+    return code, stdout.getvalue()
+
+
+@pytest.fixture(scope="module")
+def beam(tmp_path_factory):
+    """One quick study of Table 2-3: exit code, output folder, tradeoff.json,
+    stdout; run ahead by the session's prefetch worker (tests/prefetch.py)
+    when it runs."""
+    given = prefetch.scheduled(BEAM_STUDY)
+    out = given[0] if given else tmp_path_factory.mktemp("tradeoff") / "out"
+    code, stdout = prefetch.result(BEAM_STUDY, beam_study, out)
+    return code, out, json.loads((out / "tradeoff.json").read_text()), stdout
 
 
 def usable(rows):
@@ -238,11 +253,20 @@ def test_grasp_window_keeps_the_hold_and_peak_of_the_whole_scene():
     X0 = -0.457 m (Table 5-3's "-18 in") instead of -0.075 m, so that set b,
     not set a, grasps it (measured: window 0.488-2 s, hold 0.055 s, peak
     16.8 N in both)."""
-    table_5_3 = setup_of(load_scene(ROOT / "problems" / "grasp_mean_bird_hard.yaml"))
-    full = replace(table_5_3, start_x=-0.457, duration=2.0)
-    start, end = window(full)
-    assert 0.4 < start and end <= full.duration
-    whole, part = simulate(full, DEFAULT), simulate(shifted(full, start, end), DEFAULT)
+    start, end, duration, whole, part = prefetch.result(GRASP_WINDOW, grasp_window_study)
+    assert 0.4 < start and end <= duration
     assert part["hold_time_s"] > 0.04
     assert part["hold_time_s"] == pytest.approx(whole["hold_time_s"], rel=1e-3)
     assert part["max_finger_force_N"] == pytest.approx(whole["max_finger_force_N"], rel=1e-3)
+
+
+def grasp_window_study() -> tuple:
+    """The mean bird of grasp_mean_bird_hard.yaml from X0 = -0.457 m for 2 s:
+    the grasp window (start, end), the scene's duration, and the summaries
+    of the whole scene and of the window (computed ahead by the session's
+    prefetch worker, tests/prefetch.py, when it runs)."""
+    table_5_3 = setup_of(load_scene(ROOT / "problems" / "grasp_mean_bird_hard.yaml"))
+    full = replace(table_5_3, start_x=-0.457, duration=2.0)
+    start, end = window(full)
+    return (start, end, full.duration, simulate(full, DEFAULT),
+            simulate(shifted(full, start, end), DEFAULT))
