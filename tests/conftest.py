@@ -45,6 +45,7 @@ def _prefetch_jobs(session) -> list:
     from tests.design_cases import prefetch_jobs, prefetched_simulation
     from tests.test_contact_poses import REFERENCES, imposed_side_references
     from tests.test_design_solve import SETTINGS
+    from tests.test_grasp import HARD, HARD_FINE, hard_run
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
@@ -62,6 +63,11 @@ def _prefetch_jobs(session) -> list:
     simulations = prefetch_jobs(SETTINGS)
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
+    # tests/test_grasp.py's two runs, asked for before test_reports' design run
+    if fixture_used("hard_fine"):
+        jobs.append((HARD_FINE, hard_run, (4.0,), ()))
+    if fixture_used("hard"):
+        jobs.append((HARD, hard_run, (), ()))
     if fixture_used("design_run"):
         # after the loop's and the verification's baseline runs, which it uses
         jobs.append((DESIGN_RUN, solve_short_design, (folder("design"),),

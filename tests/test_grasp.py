@@ -12,19 +12,30 @@ import pytest
 from design.physics.bird import Legs
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import simulate_grasp
+from tests import prefetch
 from tests.problems import thesis_grasp_setup
 
 SKIP, DURATION = 0.0, 0.6
 
 
+#: keys of this module's runs for the prefetch worker (tests/prefetch.py)
+HARD, HARD_FINE = "test_grasp: hard", "test_grasp: hard, 4x finer"
+
+
+def hard_run(factor: float = 1.0):
+    """The hard-finger run at the default integrator's resolution times ``factor``."""
+    settings = IntegratorSettings() if factor == 1.0 else IntegratorSettings().finer(factor)
+    return simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"), settings)
+
+
 @pytest.fixture(scope="module")
 def hard():
-    return simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"))
+    return prefetch.result(HARD, hard_run)
 
 
 @pytest.fixture(scope="module")
 def hard_fine():
-    return simulate_grasp(thesis_grasp_setup(SKIP, DURATION, "hard"), IntegratorSettings().finer(4))
+    return prefetch.result(HARD_FINE, hard_run, 4.0)
 
 
 def test_default_integrator_is_within_target_of_a_4x_finer_run(hard, hard_fine):
