@@ -109,18 +109,12 @@ class StageFunctions:
             f"{name}_blocks", [x, z, c],
             [ca.jacobian(res, z), ca.jacobian(res, x), ca.jacobian(out, z), ca.jacobian(out, x)],
             ["x", "z", "c"], ["R_z", "R_x", "out_z", "out_x"])
-        zq, qq = ca.SX.sym("z", tr.n_z), ca.SX.sym("q", tr.n_q)
-        rq = tr.residual(zq, qq)
-        jac_res = ca.Function(f"{name}_jac_z", [zq, qq], [ca.jacobian(rq, zq), rq])
-        done = compiled([self.pre, self.loads, self.blocks, jac_res])
-        self.pre, self.loads, self.blocks, jac_res = done.functions
+        done = compiled([self.pre, self.loads, self.blocks])
+        self.pre, self.loads, self.blocks = done.functions
         #: whether the SX parts run compiled, and the compiler or why not
         self.compiled, self.compile_reason = done.compiled, done.reason
-        self.rootfinder = ca.rootfinder(
-            f"{name}_newton_nlp", "newton", tr.residual,
-            {"abstol": TOLERANCE, "max_iter": MAX_ITER, "error_on_fail": True,
-             "line_search": True, "linear_solver": "qr", "show_eval_warnings": False,
-             "jacobian_function": jac_res})
+        # the transcription's own Newton (its residual Jacobian compiled the same way)
+        self.rootfinder = tr.rootfinder(TOLERANCE, MAX_ITER, error_on_fail=True)
 
 
 _STAGES: dict = {}
