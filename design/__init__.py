@@ -16,6 +16,14 @@ __version__ = "0.1.0"
 # setting wins; it has no effect if numpy was imported before this package.
 _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-from design.api import check, simulate  # noqa: E402
-
 __all__ = ["check", "simulate", "__version__"]
+
+
+def __getattr__(name: str):
+    """``design.check`` and ``design.simulate``, imported on first use: a
+    process that needs only part of the toolkit (a study's worker, ``design
+    --version``) does not load the solvers, reports and plotting (1.5 s)."""
+    if name in ("check", "simulate"):
+        from design import api
+        return getattr(api, name)
+    raise AttributeError(f"module 'design' has no attribute {name!r}")
