@@ -53,3 +53,10 @@ class Interrupted(KeyboardInterrupt):
     def __init__(self, where: str, written: bool = False):
         self.where, self.written = where, written
         super().__init__(where)
+
+
+class StudyError(ValueError):
+    """A design study cannot run as asked: its case store holds cases from a
+    different problem, or from an earlier run that ``resume`` was not asked
+    to continue, or is not a case store; or its Dask scheduler cannot be
+    reached. Raised before any case runs and before the store is changed."""
