@@ -26,16 +26,22 @@ from design.run import beam as beam_run
 from design.run import contact as contact_run
 from design.run import grasp as grasp_run
 from design.run import solve as solve_run
+from design.study.cases import StudyOptions
+from design.study.store import STORE, check_store
 
 RUNNERS = {BeamScene: beam_run.run, ContactScene: contact_run.run, GraspScene: grasp_run.run,
            DesignProblem: solve_run.run}
 
 
-def run(scene: object, source: str | Path | Mapping, progress: Progress | None = None
-        ) -> RunOutput:
+def run(scene: object, source: str | Path | Mapping, progress: Progress | None = None,
+        study: StudyOptions | None = None) -> RunOutput:
     """Run a validated scene read from ``source``; a file's name, as given,
-    is kept in the result as ``scene_file`` (the report's command to rerun it)."""
-    output = RUNNERS[type(scene)](scene, progress)
+    is kept in the result as ``scene_file`` (the report's command to rerun it).
+    A design problem's runner is given ``study``: how its cases run (None:
+    the defaults, no case store)."""
+    runner = RUNNERS[type(scene)]
+    output = runner(scene, progress, study=study) if isinstance(scene, DesignProblem) \
+        else runner(scene, progress)
     if not isinstance(source, Mapping):
         output.result["scene_file"] = str(source)
     return output
@@ -69,25 +75,45 @@ def simulate(source: str | Path | Mapping, out: str | Path | None = None,
     if out is not None:
         check_output_folder(Path(out))
     with interrupt.handled():
-        output = run_scene(source, progress)
-        if out is not None:
-            write_run(Path(out), output)
-    return output.result
+        return _run_and_write(load_scene(source), source, out, progress)
 
 
 def solve(source: str | Path | Mapping, out: str | Path | None = None,
-          progress: Progress | None = None) -> dict:
+          progress: Progress | None = None, *, workers: int | None = None,
+          scheduler: str | None = None, resume: bool = False) -> dict:
     """Solve a design problem (``kind: design``, a path or the file's content):
     optimise, verify, and return the dict ``design solve`` writes to
     ``result.json`` (with ``out``, also write it, the CSV tables,
     ``optimum.yaml`` and ``report.html`` there). ``result["status"]`` says how
     it ended: ``verified``, ``no improvement found`` (the baseline is the
-    answer), ``failed verification`` or ``error`` (design/run/solve.py)."""
+    answer), ``failed verification`` or ``error`` (design/run/solve.py).
+
+    The problem's cases run on ``workers`` local processes (None: one per
+    core; 1: in this process, one after another) or on the Dask
+    ``scheduler`` at ``tcp://HOST:PORT``; with ``out``, each finished case
+    is kept in ``out/cases.sqlite`` and ``resume`` reuses them (see
+    :mod:`design.study`). Raises :class:`~design.errors.StudyError`, before
+    the run, if that store holds cases and ``resume`` is false."""
     scene = load_scene(source)
     if not isinstance(scene, DesignProblem):
         raise ValueError("design.solve needs a design problem (kind: design); "
                          "use design.simulate for scenes")
-    return simulate(source, out, progress)
+    study = StudyOptions(workers=workers, scheduler=scheduler, resume=resume,
+                         store=Path(out) / STORE if out is not None else None)
+    if out is not None:
+        check_output_folder(Path(out))
+        check_store(study.store, resume)
+    with interrupt.handled():
+        return _run_and_write(scene, source, out, progress, study)
+
+
+def _run_and_write(scene: object, source: str | Path | Mapping, out: str | Path | None,
+                   progress: Progress | None, study: StudyOptions | None = None) -> dict:
+    """Run ``scene`` and, with ``out``, write its files there; its result."""
+    output = run(scene, source, progress, study)
+    if out is not None:
+        write_run(Path(out), output)
+    return output.result
 
 
 def check(source: str | Path | Mapping) -> object:

@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from design.errors import ProblemFileError
+from design.errors import ProblemFileError, StudyError
 from design import __version__
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -45,11 +45,40 @@ def output_folder(given: str | None, default: Path) -> Path | None:
     return out
 
 
+def default_folder(scene: object, source: str) -> Path:
+    """A run's output folder when ``--out`` is not given: reports/<name>/,
+    with the scene's name, else its file's."""
+    return Path("reports") / (scene.name or Path(source).stem)
+
+
+def workers_count(text: str) -> int:
+    """``--workers``: an integer >= 1."""
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise argparse.ArgumentTypeError(
+            f"an integer >= 1 (1 runs the cases in this process, one after another; "
+            f"leave it out for one worker per core), not {text!r}. Nothing was written")
+    return n
+
+
+def scheduler_address(text: str) -> str:
+    """``--scheduler``: a Dask scheduler's address, ``tcp://HOST:PORT``."""
+    if "://" not in text:
+        raise argparse.ArgumentTypeError(f"a Dask scheduler's address such as "
+                                         f"tcp://HOST:8786, not {text!r}. Nothing was written")
+    return text
+
+
 def cmd_simulate(args: argparse.Namespace) -> int:
     from design.api import run
     from design.io.design_problem import DesignProblem
     from design.report import write_run
     from design.io.scene import load_scene
+    from design.study.cases import StudyOptions
+    from design.study.store import STORE, check_store
 
     try:
         scene = load_scene(args.scene)
@@ -61,10 +90,19 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         print(f"error: {args.scene}: kind: 'design {args.command}' needs {wanted}; use "
               f"'{other}' for this file. Nothing was written.", file=sys.stderr)
         return EXIT_BAD_INPUT
-    out = output_folder(args.out, Path("reports") / (scene.name or Path(args.scene).stem))
+    out = output_folder(args.out, default_folder(scene, args.scene))
     if out is None:
         return EXIT_BAD_INPUT
-    output = run(scene, args.scene, None if args.quiet else _progress)
+    study = None
+    try:
+        if args.command == "solve":
+            study = StudyOptions(workers=args.workers, scheduler=args.scheduler,
+                                 resume=args.resume, store=out / STORE)
+            check_store(study.store, args.resume)
+        output = run(scene, args.scene, None if args.quiet else _progress, study)
+    except StudyError as exc:
+        print(f"error: {exc}. Nothing was written.", file=sys.stderr)
+        return EXIT_BAD_INPUT
     written = write_run(out, output)
     for path in written:
         print(path)
@@ -135,7 +173,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("scene", help="design problem file (YAML, kind: design)")
     p.add_argument("--out", help="output folder (default: reports/<problem name>/)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.add_argument("--workers", type=workers_count, metavar="N",
+                   help="worker processes for the problem's cases (default: one per core; "
+                   "1: in this process, one after another)")
+    p.add_argument("--scheduler", type=scheduler_address, metavar="tcp://HOST:PORT",
+                   help="run the cases on this Dask scheduler's workers (default: "
+                   "$DASK_SCHEDULER_ADDRESS when --workers is not given)")
+    p.add_argument("--resume", action="store_true",
+                   help="reuse the finished cases in <out>/cases.sqlite, run only the rest")
     p.set_defaults(func=cmd_simulate)
+    p = sub.add_parser("cases", help="list the cases a design solve stored "
+                       "(<out>/cases.sqlite): status, hold, peak, wall time, worker")
+    p.add_argument("source", metavar="PROBLEM_OR_DB",
+                   help="design problem file (its output folder's store) or a cases.sqlite")
+    p.add_argument("--out", help="the problem's output folder (default: reports/<problem name>/)")
+    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+    p.set_defaults(func=_lazy("design.study.command", "cmd_cases"))
     p = sub.add_parser("tradeoff", help="measure error against wall time for every solver "
                        "level and resolution; pick the cheapest setting that meets a tolerance")
     p.add_argument("scene", help="scene or design problem file (YAML)")

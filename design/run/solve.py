@@ -31,6 +31,7 @@ from design.solve.optimize.transcription import rule_margins
 from design.solve.optimize.trust_region import Outcome, certify, optimise, verdict, verify
 from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
                                              timed_conveyor)
+from design.study.cases import StudyOptions
 
 #: a scaled variable this close to 0 or 1 sits on its bound
 ACTIVE = 1e-3
@@ -58,7 +59,8 @@ def design_space(problem: DesignProblem, progress: Progress | None = None) -> De
                                for n, (lo, hi) in problem.variables.items()])
 
 
-def run(problem: DesignProblem, progress: Progress | None = None) -> RunOutput:
+def run(problem: DesignProblem, progress: Progress | None = None,
+        study: StudyOptions | None = None) -> RunOutput:
     t0 = time.perf_counter()
     profile = Profile()
     say = progress or (lambda message: None)
