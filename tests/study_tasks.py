@@ -20,12 +20,14 @@ def value(calls: Path, case: Case, upstream: dict | None, *, kill: str | None = 
           spare: int | None = None) -> dict:
     """``hold_time_s`` = x / 100 plus the upstream's; ``chain`` lists the
     keys up the chain. Raises for inputs ``fail``. The case keyed ``kill``
-    kills its own process on its first attempt, unless the process is
-    ``spare`` (the test's own)."""
+    kills its own process on its first attempt, 0.2 s after it is called
+    (the cases finished before it are collected by then), unless the
+    process is ``spare`` (the test's own)."""
     time.sleep(case.inputs.get("sleep", 0.005))
     (calls / f"{quote(case.key, safe='')} {os.getpid()} {uuid.uuid4().hex}").touch()
     if case.key == kill and os.getpid() != spare and not (calls / "killed").exists():
         (calls / "killed").touch()
+        time.sleep(0.2)
         os.kill(os.getpid(), signal.SIGKILL)
     if case.inputs.get("fail"):
         raise ValueError(f"case {case.key} fails on purpose")

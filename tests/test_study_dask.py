@@ -46,14 +46,17 @@ def test_a_local_cluster_returns_the_serial_runs_results(tmp_path, serial, capsy
 
 def test_a_killed_worker_loses_no_case(tmp_path, serial):
     """Case b1 kills its worker process on its first attempt: the nanny
-    starts another, the scheduler runs b1 again, every case is stored."""
+    starts another, the scheduler runs b1 again, every case is stored.
+    Results on the lost worker that a case still needs are computed again
+    (a for b1, bad for after-bad); c, which no case needs, runs once."""
     calls = tmp_path / "calls"
     calls.mkdir()
     fn = functools.partial(value, calls, kill="b1", spare=os.getpid())
     store = tmp_path / "cases.sqlite"
     results = run_study(CASES, fn, options=StudyOptions(workers=2, store=store), label="t")
     assert (calls / "killed").exists()
-    assert called(calls).count("b1") == 2
+    made = called(calls)
+    assert made.count("b1") == 2 and made.count("c") == 1 and made.count("b2") == 1
     assert stripped(results) == serial
     assert sorted(row["key"] for row in read_cases(store)) == sorted(serial)
 

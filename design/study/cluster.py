@@ -115,8 +115,11 @@ def _check_versions(client, address: str) -> None:
 @contextmanager
 def _quiet_dask_logs() -> Iterator[None]:
     """Dask's loggers in this process at ERROR (a restarted worker, a closed
-    connection are routine here), as they were after."""
-    loggers = [logging.getLogger(name) for name in ("distributed", "dask")]
+    connection are routine here), as they were after. Each one: Dask gives
+    some (``distributed.client``) a level of their own."""
+    names = {"distributed", "dask", *(name for name in logging.root.manager.loggerDict
+                                      if name.split(".")[0] in ("distributed", "dask"))}
+    loggers = [logging.getLogger(name) for name in sorted(names)]
     levels = [log.level for log in loggers]
     for log in loggers:
         log.setLevel(logging.ERROR)

@@ -130,34 +130,40 @@ def _run_serial(todo: list[Case], task: Task, done: dict[str, dict],
 def _run_dask(todo: list[Case], task: Task, options: StudyOptions, done: dict[str, dict],
               finish: Callable[[Case, dict], None], started: Callable[[str], None]) -> None:
     """Submit every case, each needing its upstream's future (the scheduler
-    orders them) or, resumed, its stored result; record them as they finish."""
+    orders them) or, resumed, its stored result; record them as they finish.
+    Once submitted, the futures are held by ``as_completed`` alone, until
+    each is collected: then Dask forgets a case's result (a case after it
+    keeps it until it has run), so a worker lost later is not made to run
+    collected cases again."""
     from distributed import as_completed
 
     with dask_client(options, len(todo)) as (client, where):
         started(where)
-        futures, cases = {}, {}
+        submitted, cases = {}, {}
         for case in todo:
-            upstream = futures.get(case.after, done.get(case.after)) if case.after else None
+            upstream = submitted.get(case.after, done.get(case.after)) if case.after else None
             future = client.submit(_attempt, task, case, upstream, pure=False)
-            futures[case.key], cases[future.key] = future, case
+            submitted[case.key], cases[future.key] = future, case
+        running = as_completed(list(submitted.values()))
+        del submitted, future
         try:
-            for future in as_completed(list(futures.values())):
+            for future in running:
                 interrupt.checkpoint("while the study's cases ran")
                 case = cases[future.key]
-                finish(case, _collected(future, case, futures))
+                finish(case, _collected(future, case, done))
         except BaseException:
-            client.cancel(list(futures.values()))
+            client.cancel(list(running.futures))
             raise
 
 
-def _collected(future, case: Case, futures: dict) -> dict:
+def _collected(future, case: Case, done: dict[str, dict]) -> dict:
     """A finished future's result; one that Dask failed (its worker lost
     too often, or the case it needs failed so) as an error or skipped case."""
     if future.status == "finished":
         return future.result()
-    upstream = futures.get(case.after)
-    if upstream is not None and upstream.status != "finished":
-        return _skipped(case, "error")
+    upstream = done.get(case.after) if case.after else None
+    if case.after is not None and (upstream is None or upstream["status"] in FAILED):
+        return _skipped(case, upstream["status"] if upstream else "error")
     exc = future.exception()
     return {"status": "error", "message": f"{type(exc).__name__}: {exc}",
             "wall_time_s": None, "worker": None}
