@@ -81,7 +81,7 @@ from design import interrupt
 from design.study import Case, StudyOptions, StudyProgress, run_study
 from tests.study_tasks import value
 folder = Path(sys.argv[1])
-cases = [Case(f"c{i}", {"x": i, "sleep": 0.3}) for i in range(8)]
+cases = [Case(f"c{i}", {"x": i, "sleep": 0.2}) for i in range(6)]
 with interrupt.handled():
     try:
         run_study(cases, functools.partial(value, folder / "calls"), label="t",
@@ -123,10 +123,10 @@ def test_ctrl_c_stops_the_cluster_and_keeps_the_finished_cases(tmp_path, serial)
     assert "interrupted (Ctrl-C): stopped" in stderr
     assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr
     stored = [row["key"] for row in read_cases(tmp_path / "cases.sqlite")]
-    assert 1 <= len(stored) < 8
-    cases = [Case(f"c{i}", {"x": i, "sleep": 0.3}) for i in range(8)]
+    assert 1 <= len(stored) < 6
+    cases = [Case(f"c{i}", {"x": i, "sleep": 0.2}) for i in range(6)]
     fn, calls = task(tmp_path / "resumed")
     resumed = run_study(cases, fn, label="t", options=StudyOptions(
         workers=1, store=tmp_path / "cases.sqlite", resume=True))
-    assert sorted(called(calls) + stored) == [f"c{i}" for i in range(8)]
-    assert [resumed[f"c{i}"]["hold_time_s"] for i in range(8)] == [i / 100 for i in range(8)]
+    assert sorted(called(calls) + stored) == [f"c{i}" for i in range(6)]
+    assert [resumed[f"c{i}"]["hold_time_s"] for i in range(6)] == [i / 100 for i in range(6)]

@@ -150,7 +150,11 @@ def _run_dask(todo: list[Case], task: Task, options: StudyOptions, done: dict[st
             for future in running:
                 interrupt.checkpoint("while the study's cases ran")
                 case = cases[future.key]
-                finish(case, _collected(future, case, done))
+                result = _collected(future, case, done)
+                # released here, not by the garbage collector: a Ctrl-C that
+                # comes inside a __del__ is printed and lost there
+                future.release()
+                finish(case, result)
         except BaseException:
             client.cancel(list(running.futures))
             raise
