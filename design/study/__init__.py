@@ -5,7 +5,7 @@ finished case kept in an SQLite case store so a stopped study resumes.
 :class:`Case` and :class:`StudyOptions` (cases.py) describe the study,
 :func:`run_study` (engine.py) runs it, :class:`StudyProgress`
 (progress.py) shows it; store.py holds the case store, cluster.py the
-Dask cluster.
+Dask cluster, command.py the ``design cases`` command.
 """
 
 from design.study.cases import Case, StudyOptions
