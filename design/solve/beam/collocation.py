@@ -34,7 +34,10 @@ from design.physics.beam import (BeamSolution, Finger, PointLoad, classify_branc
                                  normalise_angle)
 from design.physics.stiffness import Stiffness, UniformEI
 from design.solve.beam.base import IterativeMethod, continuation_order, resample, richardson
+from design.solve.beam.condensed import Interval, condensed_step
 from design.solve.beam.frisch_fay import FrischFay, reverse_branch_exists
+from design.solve.beam.sweep import SweepFunctions, worth_compiling
+from design.solve.buffers import evaluate
 
 
 @lru_cache(maxsize=None)
@@ -109,12 +112,13 @@ class BeamTranscription:
         res = []
         u_nodes, psi_nodes, mu_nodes, x_nodes, y_nodes = [], [], [], [], []
         u0 = x0 = y0 = 0
+        intervals = []
         for j in range(K):
             h = widths[j]
             cols = [Z[:, j * (d + 1) + r] for r in range(d + 1)]
             if j == 0:
                 res.append(cols[0][0])                            # ψ(0) = 0
-            cos_c, sin_c = [], []
+            cos_c, sin_c, e, q, defects = [], [], [], [], []
             for k in range(1, d + 1):
                 u = u0 + tau[k] * h
                 zp = sum(C[r, k] * cols[r] for r in range(d + 1))
@@ -123,6 +127,11 @@ class BeamTranscription:
                 res.append((zp / h - f) / (1 + kappa))   # O(1) scale: tolerances are relative
                 cos_c.append(ca.cos(cols[k][0]))
                 sin_c.append(ca.sin(cols[k][0]))
+                e.append(e_ratio)
+                q.append(-kappa * ca.cos(cols[k][0] + alpha))
+                defects.append(zp / h - f)
+            intervals.append(Interval(h, ca.horzcat(*cols), ca.vertcat(*e), ca.vertcat(*q),
+                                      ca.horzcat(*defects)))
             end = sum(D[r] * cols[r] for r in range(d + 1))
             if j < K - 1:
                 res.append(Z[:, (j + 1) * (d + 1)] - end)          # continuity
@@ -165,7 +174,11 @@ class BeamTranscription:
         self.shape_check = ca.Function("beam_shape_check", [w, P],
                                        [*self.shape(w, P), g_max])
         self.tip_check = ca.Function("beam_tip_check", [w, P], [self.tip(w, P), g_max])
-        self._cache: dict[tuple, ca.Function] = {}
+        #: (w, P) -> max |G|, and w after one Newton step (design/solve/beam/condensed.py)
+        self.residual_norm = ca.Function("beam_residual_norm", [w, P], [g_max])
+        self.newton_step = ca.Function("beam_newton_step", [w, P],
+                                       [w + condensed_step(intervals, C, D)])
+        self._cache: dict[tuple, object] = {}
 
     def unknown_nodes(self, widths: np.ndarray) -> np.ndarray:
         """u of each (ψ, μ) pair in w, for the given interval widths."""
@@ -199,36 +212,11 @@ class BeamTranscription:
                  "show_eval_warnings": False})
         return self._cache[key]
 
-    def chain(self, n: int, parts: int = 1, tolerance: float = 1e-13) -> ca.Function:
-        """Continuation runs inside CasADi: ``parts`` runs of n solves each, in
-        parallel threads.
-
-        (A0[n_w+... x parts], P[n_p x n parts]) -> W[n_w x n parts]. Each solve
-        starts from the previous two solutions of its run extrapolated
-        linearly in F (a secant predictor: 2 Newton steps instead of 3,
-        measured); A0 holds each run's start, [w; w; F; F]. Plain Newton steps
-        (no line search, 20% faster): the start is close, and a solve that
-        fails anyway is redone by the caller.
-        """
-        key = ("chain", n, parts, tolerance)
+    def sweep(self, tolerance: float, compile: bool) -> SweepFunctions:
+        """The functions a sweep evaluates (design/solve/beam/sweep.py; cached)."""
+        key = ("sweep", tolerance, compile)
         if key not in self._cache:
-            rf = self.rootfinder(tolerance, line_search=False)
-            nw = self.n_w
-            acc = ca.MX.sym("acc", 2 * nw + 2)
-            P = ca.MX.sym("P", self.n_p)
-            w1, w2, f1, f2 = acc[:nw], acc[nw:2 * nw], acc[2 * nw], acc[2 * nw + 1]
-            slope = ca.if_else(ca.fabs(f1 - f2) > 0, (P[0] - f1) / (f1 - f2), 0)
-            w = rf(w1 + slope * (w1 - w2), P)
-            step = ca.Function("beam_step", [acc, P], [ca.vertcat(w, w1, P[0], f1), w])
-            run = step.mapaccum("beam_run", n, [0], [0])
-            self._cache[key] = run.map(parts, "thread", parts) if parts > 1 else run
-        return self._cache[key]
-
-    def mapped(self, name: str, n: int) -> ca.Function:
-        """One of this transcription's functions evaluated over n columns at once."""
-        key = (name, n)
-        if key not in self._cache:
-            self._cache[key] = getattr(self, name).map(n)
+            self._cache[key] = SweepFunctions(self, tolerance, compile)
         return self._cache[key]
 
 
@@ -325,11 +313,13 @@ class Collocation(IterativeMethod):
             [loads[j] for j in starts] + [loads[-1]])
         widths = adapted_widths(self.nodes, stiff, [seeds[0], seeds[-1]])
         forces = np.array([ld.force for ld in loads])
-        W, P = self._chain(self._fine, forces, alpha, at, seeds[:-1], starts, widths, ei_ref)
-        *shape, g_fine = (np.asarray(v) for v in self._fine.mapped("shape_check", n)(W, P))
-        W, P = self._chain(self._coarse, forces, alpha, at, seeds[:-1], starts,
-                           self._coarse_widths(widths, seeds), ei_ref)
-        coarse_tips, g_coarse = (np.asarray(v) for v in self._coarse.mapped("tip_check", n)(W, P))
+        fine, coarse = (tr.sweep(self.tolerance, worth_compiling(self._fine, n))
+                        for tr in (self._fine, self._coarse))
+        W, steps, P = self._chain(fine, forces, alpha, at, seeds[:-1], starts, widths, ei_ref)
+        *shape, g_fine = evaluate(fine.mapped("shape_check", n), W, P)
+        W, _, P = self._chain(coarse, forces, alpha, at, seeds[:-1], starts,
+                              self._coarse_widths(widths, seeds), ei_ref)
+        coarse_tips, g_coarse = evaluate(coarse.mapped("tip_check", n), W, P)
         s, x, y, psi, M = shape
         g_fine, g_coarse = g_fine[0], g_coarse[0]
         # the continued branch bends the way the transverse part pushes
@@ -344,16 +334,18 @@ class Collocation(IterativeMethod):
             if stiff.uniform else [None] * n
         return [BeamSolution(ld, self.name, s[:, j], x[:, j], y[:, j], psi[:, j], M[:, j],
                              error_estimate=float(est[j]), converged=True, branch="primary",
+                             iterations=int(steps[j]),
                              multiple_equilibria=None if flags[j] is None else bool(flags[j]),
                              extras={"K": self._fine.K, "degree": self.degree, "widths": widths,
                                      "max_residual": float(g_fine[j])})
                 if ok[j] else None for j, ld in enumerate(loads)]
 
-    def _chain(self, tr: BeamTranscription, forces: np.ndarray, alpha: float, at: float,
+    def _chain(self, sweep: SweepFunctions, forces: np.ndarray, alpha: float, at: float,
                seeds: list[BeamSolution], starts: list[int], widths: np.ndarray,
-               ei_ref: float) -> tuple[np.ndarray, np.ndarray]:
-        """Solve a sweep as len(starts) parallel runs; returns unknowns and parameters
-        (n_w x n and n_p x n)."""
+               ei_ref: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Solve a sweep as len(starts) parallel runs; returns unknowns, Newton
+        steps and parameters (n_w x n, n and n_p x n)."""
+        tr = sweep.tr
         n, parts = forces.size, len(starts)
         per = -(-n // parts)
         padded = np.concatenate([forces, np.full(per * parts - n, forces[-1])])
@@ -363,8 +355,8 @@ class Collocation(IterativeMethod):
         P[4 + tr.K:] = self.finger.stiffness.params[:, None]
         A0 = np.stack([np.concatenate([w, w, [padded[j], padded[j]]])
                        for w, j in zip((tr.guess(sd, ei_ref, widths) for sd in seeds), starts)], 1)
-        W = np.asarray(tr.chain(per, parts, self.tolerance)(A0, P)[1])
-        return W[:, :n], P[:, :n]
+        S = evaluate(sweep.chain(per, parts), A0, P)[1]
+        return S[:-1, :n], S[-1, :n], P[:, :n]
 
     def _coarse_widths(self, widths: np.ndarray, guesses: Sequence[BeamSolution]) -> np.ndarray:
         """Pairs of fine intervals merged: the same mesh map at half K (ratio exactly 2)."""

@@ -1,0 +1,69 @@
+"""Collocation sweeps: the condensed Newton step is the full system's, the
+compiled sweep computes what the interpreted one does, and a chain that
+runs out of Newton steps hands its loads to the one-by-one solve."""
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from design.physics.beam import PointLoad
+from design.physics.stiffness import UniformEI
+from design.solve import compiled as comp
+from design.solve.beam import collocation, solve_beam, sweep
+from design.solve.beam.collocation import BeamTranscription
+from tests.problems import table_2_3, thesis_finger, tip_distance
+
+
+@pytest.mark.parametrize("stiffness", [thesis_finger().stiffness, UniformEI(0.08)])
+@pytest.mark.parametrize("intervals, degree", [(16, 4), (5, 3), (3, 1)])
+def test_condensed_step_is_the_newton_step_of_the_whole_system(stiffness, intervals, degree):
+    tr = BeamTranscription(stiffness, intervals, degree)
+    rng = np.random.default_rng(intervals)
+    widths = rng.dirichlet(np.ones(intervals))                   # a graded mesh
+    P = np.concatenate([[20.0, 1.2, 0.0762, 0.05], widths, stiffness.params])
+    w = 0.3 * rng.normal(size=tr.n_w)                            # far from the solution
+    ws, ps = ca.SX.sym("w", tr.n_w), ca.SX.sym("P", tr.n_p)
+    jac = ca.Function("jacobian", [ws, ps], [ca.jacobian(tr.residual(ws, ps), ws)])
+    newton = w - np.linalg.solve(np.asarray(jac(w, P)), np.asarray(tr.residual(w, P)).ravel())
+    step = np.asarray(tr.newton_step(w, P)).ravel()
+    assert np.max(np.abs(step - newton)) <= 1e-12 * np.max(np.abs(newton - w))
+
+
+@pytest.fixture
+def fresh(monkeypatch):
+    """No transcription (with its sweep functions) built yet."""
+    monkeypatch.setattr(collocation, "_TRANSCRIPTIONS", {})
+
+
+def sweep_loads(n):
+    finger, load = table_2_3()
+    return finger, [PointLoad(f, 1.2, load.at) for f in np.linspace(0.5, 30.0, n)]
+
+
+@pytest.mark.skipif(comp.compiler()[0] is None, reason="no C compiler")
+def test_compiled_sweep_computes_what_the_interpreted_one_does(fresh, monkeypatch):
+    finger, loads = sweep_loads(40)
+    monkeypatch.setattr(sweep, "COMPILE_MIN_LOADS", 10)
+    fast = solve_beam(finger, loads, "collocation", nodes=4, degree=2)
+    assert "beam_continuation_step" in comp.status.libraries[-1]["functions"]
+    monkeypatch.setattr(sweep, "COMPILE_MIN_LOADS", 10 ** 9)
+    slow = solve_beam(finger, loads, "collocation", nodes=4, degree=2)
+    assert all(a.converged and b.converged for a, b in zip(fast, slow))
+    assert [a.iterations for a in fast] == [b.iterations for b in slow]
+    assert max(tip_distance(a, b) for a, b in zip(fast, slow)) < 1e-15
+    np.testing.assert_allclose([a.error_estimate for a in fast],
+                               [b.error_estimate for b in slow], rtol=1e-9)
+
+
+def test_a_chain_out_of_newton_steps_leaves_its_loads_to_single_solves(fresh, monkeypatch):
+    finger, loads = sweep_loads(6)                 # 6 N apart: a start one step cannot finish
+    chained = solve_beam(finger, loads, "collocation")
+    assert all(s.converged and s.iterations >= 1 for s in chained)
+    assert max(s.iterations for s in chained) >= 2
+    monkeypatch.setattr(collocation, "_TRANSCRIPTIONS", {})
+    monkeypatch.setattr(sweep, "MAX_STEPS", 1)
+    redone = solve_beam(finger, loads, "collocation")
+    assert all(s.converged for s in redone)
+    assert any(s.iterations > 1 for s in redone)   # solved one by one, from the seed
+    for a, b in zip(chained, redone):
+        assert tip_distance(a, b) <= a.error_estimate + b.error_estimate
