@@ -17,8 +17,8 @@ from design.cli import main
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPSettings
-from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, simulate,
-                                                verdict, verify)
+from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, score,
+                                                simulate, verdict, verify)
 from tests.design_cases import sharing_simulations, short_problem_file, stiffness_space
 
 SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
@@ -125,9 +125,9 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
                               {"groups.lower.stiffness_scale": [0.5, 2.0]},
                               max_iter=20, outer_iterations=0)
 
-    def over_the_cap(space, cap, settings, rules, start, progress):
-        base = simulate(space, space.scale(space.base_values), settings)
-        return Outcome(simulate(space, [1.0], settings), base, cap)
+    def over_the_cap(population, caps, settings, rules, start, progress):
+        d0 = population.space.scale(population.space.base_values)
+        return Outcome(score(population, [1.0], settings), score(population, d0, settings), caps)
 
     monkeypatch.setattr("design.run.solve.optimise", over_the_cap)
     assert main(["solve", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1

@@ -123,6 +123,12 @@ class NLPResult:
     x: np.ndarray
     lam_g: np.ndarray
     lam_x: np.ndarray
+    #: the largest finger force (N) of each bird (default: one bird, ``peak_force``)
+    peaks: np.ndarray | None = None
+
+    def __post_init__(self):
+        if self.peaks is None:
+            self.peaks = np.array([self.peak_force])
 
 
 class DesignNLP:
@@ -336,6 +342,8 @@ class DesignNLP:
         self._cap_rows = np.array([t == "cap" for t in tags], bool)
         self._size, self._solver = None, None
         self.n_design, self.n_phases = n, len(sch.phases)
+        #: where the objective's hold time (s) sits in x
+        self.hold_index = n + sch.hold
         if self.objective == "hold":
             self.f = -durations[sch.hold] / OBJECTIVE_SCALE
         else:       # "track": the simulated phase durations, where events leave slack
@@ -450,17 +458,25 @@ class DesignNLP:
             raise NLPFailed(f"Ipopt ended on an error, {stats['return_status']}, after "
                             f"{stats['iter_count']} iterations")
         x = np.asarray(sol["x"]).ravel()
-        n, m = self.n_design, self.n_phases
         try:
             with _casadi_output_muted():
                 force = np.asarray(self.functions(x)[2]).ravel()
         except RuntimeError:          # Ipopt stopped at a point a contact cannot reach
-            force = np.array([np.inf])
-        return NLPResult(x[:n], x[n:n + m], float(x[n + self.schedule.hold]),
-                         float(force.max()) if force.size else 0.0, stats["return_status"],
+            force = np.full(self.force.numel(), np.inf)
+        peaks = self.peaks(force)
+        return NLPResult(x[:self.n_design], self.durations(x), float(x[self.hold_index]),
+                         float(peaks.max()), stats["return_status"],
                          bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
                          history, x, np.asarray(sol["lam_g"]).ravel(),
-                         np.asarray(sol["lam_x"]).ravel())
+                         np.asarray(sol["lam_x"]).ravel(), peaks)
+
+    def durations(self, x: np.ndarray) -> np.ndarray:
+        """The phase durations (s) in the solution x."""
+        return x[self.n_design:self.n_design + self.n_phases]
+
+    def peaks(self, force: np.ndarray) -> np.ndarray:
+        """The largest finger force (N) of each bird, from every stage's forces."""
+        return np.array([force.max() if force.size else 0.0])
 
 
 def _stats(solver) -> dict:
@@ -529,7 +545,7 @@ class _Progress(ca.Callback):
         self.nx, self.ng = nlp.x.numel(), nlp.g.numel()
         self.lbg, self.ubg = nlp.lbg, nlp.ubg
         self.history, self.report = history, progress
-        self.hold_index = nlp.n_design + nlp.schedule.hold
+        self.hold_index = nlp.hold_index
         self.stall = nlp.settings.stall_iterations, nlp.settings.stall_violation
         self.streams = sys.stdout, sys.stderr
         #: an exception in the callback, which ends the solve as an error

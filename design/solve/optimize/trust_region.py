@@ -46,6 +46,7 @@ import numpy as np
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import GraspRun, simulate_grasp
 from design.solve.grasp.validity import validity_problems
+from design.solve.optimize.population import Population, PopulationNLP
 from design.solve.optimize.profile import CONSTRUCTION, OPTIMISER, SIMULATIONS, VIEWS, Profile
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPResult, NLPSettings, Rules
@@ -104,24 +105,78 @@ class Evaluated:
 
 
 @dataclass
+class Scored:
+    """A design simulated for every bird of a population: ``hold`` is the
+    population's (its aggregate), ``peaks`` each bird's largest finger force
+    (N), ``run`` the limiting bird's simulation (the only one for one bird)."""
+
+    d: np.ndarray
+    members: list[Evaluated]
+    population: Population
+
+    @property
+    def holds(self) -> np.ndarray:
+        return np.array([m.hold for m in self.members])
+
+    @property
+    def hold(self) -> float:
+        return self.population.hold(self.holds)
+
+    @property
+    def peaks(self) -> np.ndarray:
+        return np.array([m.peak for m in self.members])
+
+    @property
+    def peak(self) -> float:
+        return float(self.peaks.max())
+
+    @property
+    def limiting(self) -> int:
+        """The bird with the shortest hold."""
+        return int(np.argmin(self.holds))
+
+    @property
+    def run(self) -> GraspRun:
+        return self.members[self.limiting].run
+
+    def within(self, caps, tolerance: float = 0.0) -> bool:
+        """Does every bird stay under its cap (N), within ``tolerance`` (relative)?"""
+        return bool(np.all(self.peaks <= np.asarray(caps) * (1 + tolerance)))
+
+
+@dataclass
 class Outcome:
     """What the loop found, and how."""
 
-    best: Evaluated
-    baseline: Evaluated
-    cap: float
+    best: Scored
+    baseline: Scored
+    #: each bird's cap (N)
+    caps: np.ndarray
     iterations: list = field(default_factory=list)
     nlp: NLPResult | None = None
-    final: NLPResult | None = None
+    #: each bird's fixed-design view of ``best`` (None: not yet, or it failed)
+    finals: list | None = None
     #: the optimiser's hold for ``best`` and where it comes from (None: not yet)
     claim: tuple | None = None
+    #: each bird's claim (hold (s), source)
+    claims: list | None = None
     wall_time: float = 0.0
     #: where the loop's time went (its simulations, NLPs and views)
     profile: Profile = field(default_factory=Profile)
 
     @property
+    def cap(self) -> float:
+        """The first bird's cap (N): the cap of a single-bird problem."""
+        return float(self.caps[0])
+
+    @property
+    def final(self) -> NLPResult | None:
+        """The first bird's fixed-design view (a single-bird problem's)."""
+        return self.finals[0] if self.finals else None
+
+    @property
     def feasible(self) -> bool:
-        return self.best.peak <= self.cap * (1 + CAP_TOLERANCE)
+        return self.best.within(self.caps, CAP_TOLERANCE)
 
     @property
     def every_nlp_failed(self) -> bool:
@@ -145,57 +200,74 @@ def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
     return Evaluated(np.asarray(d, float), run)
 
 
-def better(a: Evaluated, b: Evaluated, cap: float) -> bool:
-    """Is a better than b: feasible beats infeasible, then longer hold;
-    among infeasible designs the lower peak force."""
-    fa, fb = a.peak <= cap, b.peak <= cap
+def score(population: Population, d: np.ndarray, settings: LoopSettings,
+          integrator: IntegratorSettings | None = None) -> Scored:
+    """Simulate the scaled design ``d`` for every bird of the population."""
+    return Scored(np.asarray(d, float), [simulate(m.space, d, settings, integrator)
+                                         for m in population.members], population)
+
+
+def better(a: Scored, b: Scored, caps) -> bool:
+    """Is a better than b: feasible (every bird under its cap) beats
+    infeasible, then the longer hold; among infeasible designs the smaller
+    largest excess over a cap."""
+    fa, fb = a.within(caps), b.within(caps)
     if fa != fb:
         return fa
     if fa:
         return a.hold > b.hold + 1e-5
-    return a.peak < b.peak - 1e-3
+    return np.max(a.peaks - caps) < np.max(b.peaks - caps) - 1e-3
 
 
-def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rules = Rules(),
-             start: np.ndarray | None = None, progress=None) -> Outcome:
-    """Maximise the hold time under the cap (N) from ``start`` (scaled; the
-    baseline by default)."""
+def population_of(space: DesignSpace | Population) -> Population:
+    return space if isinstance(space, Population) else Population.of(space)
+
+
+def optimise(space: DesignSpace | Population, cap, settings: LoopSettings,
+             rules: Rules = Rules(), start: np.ndarray | None = None, progress=None,
+             anchor: bool = True) -> Outcome:
+    """Maximise the (population's) hold time under the cap (N; one per bird,
+    or one for all) from ``start`` (scaled; the baseline by default). With
+    ``anchor`` a start worse than the baseline gives way to it (a warm
+    start); without, the loop goes from the start (a multistart's point)."""
     t0 = time.perf_counter()
     profile = Profile()
     say = progress or (lambda message: None)
-    d0 = space.scale(space.base_values)
+    population = population_of(space)
+    caps = np.broadcast_to(np.asarray(cap, float), (len(population.members),)).copy()
+    d0 = population.space.scale(population.space.base_values)
     with profile.phase(SIMULATIONS):
-        baseline = simulate(space, d0, settings)
+        baseline = score(population, d0, settings)
     if start is None:
         best = baseline
     else:
         with profile.phase(SIMULATIONS):
-            best = simulate(space, start, settings)
-    if start is not None and better(baseline, best, cap):
+            best = score(population, start, settings)
+    if start is not None and anchor and better(baseline, best, caps):
         best = baseline
-    out = Outcome(best, baseline, cap, profile=profile)
-    radius, backed_off = settings.radius, cap
-    # the last NLP and the run whose schedule it was built on: after a rejected
-    # candidate the best design, hence the schedule, is the same, and only the
-    # cap and the trust region change (DesignNLP.rebound; the same solution
-    # as a new NLP's, without building the graph and the solver again)
+    out = Outcome(best, baseline, caps, profile=profile)
+    radius, backed_off = settings.radius, caps.copy()
+    # the last NLP and the design whose schedules it was built on: after a
+    # rejected candidate the best design, hence the schedule, is the same, and
+    # only the caps and the trust region change (DesignNLP.rebound; the same
+    # solution as a new NLP's, without building the graph and the solver again)
     built: dict = {}
 
     def nlp_for(cap_nlp, box):
-        if built.get("run") is best.run:
-            return built["nlp"].rebound(cap_nlp, box)
-        nlp = DesignNLP(space, schedule_of(best.run, settings.nlp.time_step), best.run, cap_nlp,
-                        settings.nlp, rules, box, progress)
-        built.update(run=best.run, nlp=nlp)
+        if built.get("best") is best:
+            return rebound(built["nlp"], cap_nlp, box)
+        nlp = build_nlp(population, best, cap_nlp, settings, rules, box, progress)
+        built.update(best=best, nlp=nlp)
         return nlp
 
     say(f"baseline: hold {baseline.hold:.4f} s, peak finger force {baseline.peak:.2f} N "
-        f"(cap {cap:.2f} N)")
+        f"(cap {caps_text(caps)})")
     for it in range(settings.outer_iterations):
-        cap_nlp = min(backed_off, cap * (1 - settings.cap_margin / 2 ** it))
+        cap_nlp = np.minimum(backed_off, caps * (1 - settings.cap_margin / 2 ** it))
         lo = np.clip(best.d - radius, 0, 1)
         hi = np.clip(best.d + radius, 0, 1)
-        say(f"outer iteration {it + 1}: trust region {radius:.3f}, NLP cap {cap_nlp:.2f} N")
+        say(f"outer iteration {it + 1}: trust region {radius:.3f}, NLP cap "
+            f"{caps_text(cap_nlp)}")
         try:
             result = build_and_solve(profile, OPTIMISER, lambda: nlp_for(cap_nlp, (lo, hi)))
         except (RuntimeError, ValueError) as exc:
@@ -206,20 +278,20 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
                 break
             continue
         with profile.phase(SIMULATIONS):
-            candidate = simulate(space, result.d, settings)
-        accepted = better(candidate, best, cap)
-        reproduced, view, view_error = None, None, None
+            candidate = score(population, result.d, settings)
+        accepted = better(candidate, best, caps)
+        reproduced, views, view_error, claims = None, None, None, None
         if accepted:
             # stand only on designs whose simulation the optimiser's grid reproduces
-            try:
-                view = optimiser_view(space, candidate, settings, rules, progress, profile)
-            except (RuntimeError, ValueError) as exc:
-                view_error = f"the fixed-design NLP failed: {exc}"
-            claim = optimiser_hold(view, result)
-            reproduced = reproduces(candidate, claim[0])
+            views, view_error = optimiser_views(population, candidate, settings, rules,
+                                                progress, profile)
+            claims = [optimiser_hold(view, result if len(views) == 1 else None)
+                      for view in views]
+            reproduced = all(reproduces(m, c[0]) for m, c in zip(candidate.members, claims))
             accepted = reproduced
+        view = views[0] if views else None
         out.iterations.append({
-            "iteration": it + 1, "radius": radius, "nlp_cap_N": cap_nlp,
+            "iteration": it + 1, "radius": radius, "nlp_cap_N": caps_value(cap_nlp),
             "ipopt_status": result.status, "ipopt_iterations": result.iterations,
             "nlp_wall_time_s": result.wall_time, "nlp_hold_time_s": result.hold_time,
             "nlp_peak_force_N": result.peak_force, "simulated_hold_time_s": candidate.hold,
@@ -229,18 +301,24 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
                 "ipopt_status": view.status, "ipopt_iterations": view.iterations,
                 "wall_time_s": view.wall_time, "hold_time_s": view.hold_time,
                 "constraint_violation": view.history[-1]["violation"] if view.history else None},
-            "nlp_size": result.size, "history": result.history})
+            "nlp_size": result.size, "history": result.history,
+            **({} if len(caps) == 1 else {
+                "simulated_hold_times_s": candidate.holds.tolist(),
+                "simulated_peak_forces_N": candidate.peaks.tolist()})})
         verdict_text = "accepted" if accepted else "rejected" if reproduced is None else \
             "rejected: the optimiser's grid does not reproduce its simulation"
         say(f"outer iteration {it + 1}: Ipopt {result.status} in {result.iterations} "
             f"iterations; NLP hold {result.hold_time:.4f} s, simulated {candidate.hold:.4f} s, "
             f"peak {candidate.peak:.2f} N -> {verdict_text}")
-        if candidate.peak > cap and result.peak_force <= cap_nlp * (1 + 1e-3):
-            # the NLP kept its grid under the cap but the simulation found more
-            # between the stages or in a contact the schedule lacked: back off
-            backed_off = cap_nlp * max(BACK_OFF, cap / candidate.peak)
+        # where the NLP kept its grid under a bird's cap but the simulation found
+        # more between the stages or in a contact the schedule lacked: back off
+        over = (candidate.peaks > caps) & (result.peaks <= cap_nlp * (1 + 1e-3))
+        backed_off = np.where(over, cap_nlp * np.maximum(BACK_OFF, caps / candidate.peaks),
+                              backed_off)
         if accepted:
-            best, out.nlp, out.final, out.claim = candidate, result, view, claim
+            best, out.nlp, out.finals = candidate, result, views
+            out.claims = claims
+            out.claim = population.hold([c[0] for c in claims]), claims[0][1]
             radius = min(2 * radius, 0.5)
         else:
             radius /= 2
@@ -249,6 +327,34 @@ def optimise(space: DesignSpace, cap: float, settings: LoopSettings, rules: Rule
     out.best = best
     out.wall_time = time.perf_counter() - t0
     return out
+
+
+def build_nlp(population: Population, best: Scored, caps, settings: LoopSettings,
+              rules: Rules, box, progress=None) -> DesignNLP:
+    """The NLP around ``best``'s simulated schedules: the bird's own NLP for
+    one bird, the population's for several."""
+    step = settings.nlp.time_step
+    if len(population.members) == 1:
+        run = best.members[0].run
+        return DesignNLP(population.space, schedule_of(run, step), run, float(caps[0]),
+                         settings.nlp, rules, box, progress)
+    runs = [m.run for m in best.members]
+    return PopulationNLP(population, [schedule_of(r, step) for r in runs], runs, caps,
+                         settings.nlp, rules, box, progress)
+
+
+def rebound(nlp: DesignNLP, caps, box) -> DesignNLP:
+    return nlp.rebound(caps if isinstance(nlp, PopulationNLP) else float(caps[0]), box)
+
+
+def caps_value(caps: np.ndarray):
+    """The caps (N) as result.json gives them: a number for one bird."""
+    return float(caps[0]) if len(caps) == 1 else caps.tolist()
+
+
+def caps_text(caps: np.ndarray) -> str:
+    return f"{caps[0]:.2f} N" if len(caps) == 1 else \
+        "[" + ", ".join(f"{c:.2f}" for c in caps) + "] N"
 
 
 #: the optimiser's view counts when its largest constraint violation (m, m/s,
@@ -310,36 +416,56 @@ def optimiser_view(space: DesignSpace, evaluated: Evaluated, settings: LoopSetti
         nlp_settings, rules, (evaluated.d, evaluated.d), progress, objective="track"))
 
 
+def optimiser_views(population: Population, scored: Scored, settings: LoopSettings,
+                    rules: Rules = Rules(), progress=None, profile: Profile | None = None
+                    ) -> tuple[list, str | None]:
+    """Each bird's :func:`optimiser_view` of a design (None where it failed),
+    and the failures' message (None if every view was built and solved)."""
+    views, errors = [], []
+    for member, evaluated in zip(population.members, scored.members):
+        try:
+            views.append(optimiser_view(member.space, evaluated, settings, rules, progress,
+                                        profile))
+        except (RuntimeError, ValueError) as exc:
+            views.append(None)
+            errors.append(str(exc) if len(scored.members) == 1 else f"{member.name}: {exc}")
+    return views, ("the fixed-design NLP failed: " + "; ".join(errors)) if errors else None
+
+
 def reproduces(evaluated: Evaluated, claimed: float) -> bool:
     """Does the optimiser's grid reproduce this simulated hold time?"""
     return bool(np.isfinite(claimed)) and abs(evaluated.hold - claimed) <= HOLD_TOLERANCE * claimed
 
 
-def certify(space: DesignSpace, outcome: Outcome, settings: LoopSettings,
+def certify(space: DesignSpace | Population, outcome: Outcome, settings: LoopSettings,
             rules: Rules = Rules(), progress=None) -> tuple[float, str]:
-    """The optimiser's hold time (s) for ``outcome.best`` and its source;
-    designs the loop accepted have it already, the start design gets its
-    fixed-design NLP now."""
+    """The optimiser's hold time (s) for ``outcome.best`` and its source
+    (``outcome.claims`` has each bird's); designs the loop accepted have it
+    already, the start design gets its fixed-design NLPs now."""
     if outcome.claim is None:
+        population = population_of(space)
         (progress or (lambda message: None))("the optimiser's view of the design on its "
                                              "own schedule")
-        try:
-            outcome.final = optimiser_view(space, outcome.best, settings, rules, progress,
-                                           outcome.profile)
-        except (RuntimeError, ValueError) as exc:
-            outcome.claim = float("nan"), f"none: the fixed-design NLP failed ({exc})"
-        else:
-            outcome.claim = optimiser_hold(outcome.final, outcome.nlp)
+        views, error = optimiser_views(population, outcome.best, settings, rules, progress,
+                                       outcome.profile)
+        outcome.finals = views
+        outcome.claims = [
+            (float("nan"), f"none: {error}") if view is None else
+            optimiser_hold(view, outcome.nlp if len(views) == 1 else None) for view in views]
+        outcome.claim = (population.hold([c[0] for c in outcome.claims]),
+                         next((c[1] for c in outcome.claims if not np.isfinite(c[0])),
+                              outcome.claims[0][1]))
     return outcome.claim
 
 
-def verify(space: DesignSpace, d: np.ndarray, settings: LoopSettings, factor: float = 4.0
-           ) -> Evaluated:
-    """Re-simulate at ``factor`` times the optimiser's resolution: steps no
-    longer than its grid step / factor, tolerances tightened by factor^4."""
+def verify(space: DesignSpace | Population, d: np.ndarray, settings: LoopSettings,
+           factor: float = 4.0) -> Scored:
+    """Re-simulate every bird at ``factor`` times the optimiser's resolution:
+    steps no longer than its grid step / factor, tolerances tightened by
+    factor^4."""
     s = settings.simulator
     fine = replace(s.finer(factor), max_step=min(s.max_step, settings.nlp.time_step) / factor)
-    return simulate(space, d, settings, fine)
+    return score(population_of(space), d, settings, fine)
 
 
 def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
@@ -356,3 +482,29 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
             "hold_tolerance": HOLD_TOLERANCE, "cap_tolerance": CAP_TOLERANCE,
             "model_warnings": validity_problems(s["validity"]),
             "passed": bool(passed)}
+
+
+def population_verdict(population: Population, claims: list, verified: Scored, caps) -> dict:
+    """:func:`verdict` for every bird (``birds``); the top-level numbers are
+    the population's: its hold, the worst hold disagreement, the bird
+    closest to (or furthest over) its cap. One bird: that bird's verdict."""
+    if len(population.members) == 1:
+        return verdict(claims[0][0], verified, float(caps[0]))
+    birds = [{"bird": m.name, "weight": float(w), **verdict(c[0], e, float(cap))}
+             for m, w, c, e, cap in zip(population.members, population.weights, claims,
+                                        verified.members, caps)]
+    k = int(np.argmax(verified.peaks / np.asarray(caps)))
+    tight, limiting = birds[k], birds[verified.limiting]
+    return {"aggregate": population.aggregate, "hold_time_s": verified.hold,
+            "hold_windows": limiting["hold_windows"], "limiting_bird": limiting["bird"],
+            "max_finger_force_N": tight["max_finger_force_N"],
+            "max_finger_force_finger": tight["max_finger_force_finger"],
+            "max_finger_force_time_s": tight["max_finger_force_time_s"],
+            "max_finger_force_bird": tight["bird"], "cap_N": tight["cap_N"],
+            "optimiser_hold_time_s": population.hold([c[0] for c in claims]),
+            "hold_time_relative_difference": max(b["hold_time_relative_difference"]
+                                                 for b in birds),
+            "hold_tolerance": HOLD_TOLERANCE, "cap_tolerance": CAP_TOLERANCE,
+            "model_warnings": list(dict.fromkeys(f"{b['bird']}: {w}" for b in birds
+                                                 for w in b["model_warnings"])),
+            "passed": all(b["passed"] for b in birds), "birds": birds}
