@@ -11,7 +11,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from design.errors import ProblemFileError, StudyError
+from design.errors import ProblemFileError, StudyError, StudyFailed
 from design import __version__
 
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT = 0, 1, 2
@@ -103,6 +103,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
     except StudyError as exc:
         print(f"error: {exc}. Nothing was written.", file=sys.stderr)
         return EXIT_BAD_INPUT
+    except StudyFailed as exc:
+        print(f"FAILED: {exc}. No result was written; the finished cases are in "
+              f"{study.store}, and --resume runs the failed ones again.", file=sys.stderr)
+        return EXIT_FAILED
     written = write_run(out, output)
     for path in written:
         print(path)

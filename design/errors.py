@@ -60,3 +60,8 @@ class StudyError(ValueError):
     different problem, or from an earlier run that ``resume`` was not asked
     to continue, or is not a case store; or its Dask scheduler cannot be
     reached. Raised before any case runs and before the store is changed."""
+
+
+class StudyFailed(RuntimeError):
+    """A case of a design study ended in an error (or was skipped after one):
+    the run fails, naming each such case; the finished cases stay in the store."""

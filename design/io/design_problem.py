@@ -12,6 +12,10 @@ bounds, the bruise cap, the design rules and the solver settings.
       fingers.4.angle: [-165 deg, -135 deg]
     cap: baseline              # N | baseline | {relative_to_baseline: 0.75} | a list: Pareto study
     rules: {sigma_lambda: 0.01, bird_spacing: 0.3}   # finger_sets: the grasper's sets
+    population:                # optional: one design for several birds (robust design)
+      objective: worst         # worst (the shortest hold) | mean (weighted by ``weight``)
+      birds: [models/birds/small_1_20kg.yaml, {bird: models/birds/large_2_30kg.yaml, weight: 2}]
+    multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}
 
@@ -28,12 +32,17 @@ from pathlib import Path
 
 from design.errors import ProblemFileError
 from design.io.files import resolve
-from design.io.grasp_scene import GraspScene
+from design.io.grasp_scene import GraspScene, read_bird
 from design.io.reader import Reader, did_you_mean, join
+from design.physics.bird import Bird
+from design.solve.optimize.population import AGGREGATES
 from design.solve.optimize.transcription import NLPSettings, Rules
 from design.solve.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
 from design.solve.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
                                              GROUP_FIELDS)
+
+#: starting designs of ``multistart: {}`` (the baseline and seven Sobol points)
+DEFAULT_STARTS = 8
 
 DIMENSIONS = {"angle": "angle", "phi_x": "angle", "phi_y": "angle", "length": "length",
               "height": "length", "stiffness_scale": "dimensionless", "start_time": "time",
@@ -59,6 +68,25 @@ class Cap:
 
 
 @dataclass(frozen=True)
+class PopulationSpec:
+    """The birds a robust design must hold, their weights (for ``mean``) and
+    how their holds combine (design/solve/optimize/population.py)."""
+
+    birds: tuple[Bird, ...]
+    weights: tuple[float, ...]
+    objective: str = "worst"
+
+
+@dataclass(frozen=True)
+class MultistartSpec:
+    """How many starting designs (the baseline is one of them) and the Sobol
+    sequence's seed; one start: the baseline alone, no multistart."""
+
+    starts: int = 1
+    seed: int = 0
+
+
+@dataclass(frozen=True)
 class DesignProblem:
     name: str
     scene: GraspScene
@@ -67,6 +95,10 @@ class DesignProblem:
     rules: Rules
     settings: LoopSettings
     description: str = ""
+    #: several birds (robust design), or None: the scene's bird alone
+    population: PopulationSpec | None = None
+    #: the loop from several starting designs (design/solve/optimize/multistart.py)
+    multistart: MultistartSpec = MultistartSpec()
 
     @property
     def pareto(self) -> bool:
@@ -88,7 +120,12 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     caps = _caps(reader, data.get("cap", "baseline"))
     rules = _rules(reader, data.get("rules", {}))
     settings = _settings(reader, data.get("solver", {}))
-    if not reader.ok or None in (scene, variables, caps, rules, settings):
+    population = _population(reader, data["population"], base_dir) \
+        if "population" in data else None
+    multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
+        else MultistartSpec()
+    if not reader.ok or None in (scene, variables, caps, rules, settings, multistart) or \
+            ("population" in data and population is None):
         return None
     # the loop's simulations use the scene's integrator, no looser than the
     # loop's own tolerances (trust_region.LOOP_SIMULATOR), with the NLP's finger mesh
@@ -96,7 +133,7 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     settings = replace(settings, simulator=replace(
         given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol)))
     return DesignProblem(name, scene, variables, caps, rules, settings,
-                         data.get("description", ""))
+                         data.get("description", ""), population, multistart)
 
 
 def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
@@ -204,6 +241,50 @@ def _caps(reader: Reader, value: object) -> list[Cap] | None:
             if v is not None:
                 caps.append(Cap(value=v))
     return caps if len(caps) == len(items) else None
+
+
+def _population(reader: Reader, value: object, base_dir: Path) -> PopulationSpec | None:
+    spec = reader.mapping(value, "population", required=("birds",), optional=("objective",))
+    if spec is None:
+        return None
+    objective = reader.choice(spec, "objective", "population", AGGREGATES, default="worst")
+    items = spec["birds"]
+    if not isinstance(items, list) or not items:
+        reader.add("population.birds", "expected a non-empty list of birds (model files or "
+                   "inline mappings, each optionally {bird: ..., weight: w})")
+        return None
+    birds, weights = [], []
+    for i, item in enumerate(items):
+        path = join("population.birds", i)
+        weight: float | None = 1.0
+        if isinstance(item, Mapping) and "bird" in item:
+            entry = reader.mapping(item, path, required=("bird",), optional=("weight",))
+            if entry is None:
+                continue
+            weight = reader.quantity(entry, "weight", path, "dimensionless", lo=0.0,
+                                     lo_open=True, default=1.0)
+            item, path = entry["bird"], join(path, "bird")
+        bird = read_bird(reader, item, path, base_dir)
+        if bird is not None and weight is not None:
+            birds.append(bird)
+            weights.append(weight)
+    names = [b.name for b in birds]
+    for name in {n for n in names if names.count(n) > 1}:
+        reader.add("population.birds", f"the bird '{name}' is listed twice: each bird once, "
+                   "with a weight for its share")
+    if objective is None or len(birds) != len(items):
+        return None
+    return PopulationSpec(tuple(birds), tuple(weights), objective)
+
+
+def _multistart(reader: Reader, value: object) -> MultistartSpec | None:
+    spec = reader.mapping(value, "multistart", optional=("starts", "seed"))
+    if spec is None:
+        return None
+    starts = reader.integer(spec, "starts", "multistart", lo=1, hi=1024,
+                            default=DEFAULT_STARTS)
+    seed = reader.integer(spec, "seed", "multistart", lo=0, hi=2 ** 31 - 1, default=0)
+    return None if None in (starts, seed) else MultistartSpec(starts, seed)
 
 
 def _rules(reader: Reader, value: object) -> Rules | None:

@@ -28,7 +28,8 @@ KINDS = {
                 ("sliding", "motion", "solver"), read_contact),
     "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
               ("finger_models", "mounts", "friction", "legs", "finger_model", "solver"), read_grasp),
-    "design": (("scene", "variables"), ("cap", "rules", "solver"), read_design),
+    "design": (("scene", "variables"), ("cap", "rules", "solver", "population",
+                                             "multistart"), read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)
 _COMMON = ("kind", "name", "description")

@@ -82,6 +82,41 @@ def profile_table(page: Page, profile: dict) -> None:
     page.table(profile_rows(profile), "Where the time went", "profile-table")
 
 
+def population_section(page: Page, population: dict) -> None:
+    """Each bird under the baseline, the single-bird optimum and the robust optimum."""
+    page.section("Birds of the population", "population")
+    holds, limiting = population["hold_time_s"], population["limiting_bird"]
+    aggregate = "the shortest hold" if population["objective"] == "worst" else \
+        "the weighted mean hold"
+    page.text(f"Objective: {aggregate} over the birds; each bird's cap is given beside it. "
+              f"The single-bird optimum is {population['single_bird']} optimised alone (cap "
+              f"{population['single_bird_cap_N']:.2f} N). Population hold: baseline "
+              f"{holds['baseline']:.4f} s (limited by {limiting['baseline']}), single-bird "
+              f"optimum {holds['single_bird_optimum']:.4f} s ({limiting['single_bird_optimum']}"
+              f"{'' if population['within_caps']['single_bird_optimum'] else ', breaks a cap'}"
+              f"), robust optimum {holds['robust_optimum']:.4f} s "
+              f"({limiting['robust_optimum']}). Every number is from the independent "
+              f"simulation at 4x the optimiser's resolution.")
+    page.table(population["birds"], "Hold (s) and peak finger force (N) of every bird",
+               "population-table")
+
+
+def multistart_section(page: Page, multistart: dict) -> None:
+    """The starts and the distinct optima they reached."""
+    page.section("Starts and local optima", "multistart")
+    unverified = multistart["unverified_starts"]
+    page.text(f"{len(multistart['starts'])} starts (the baseline and scrambled Sobol points, "
+              f"seed {multistart['seed']}); one optimum: {multistart['same_optimum']}."
+              + (f" Starts not verified: {', '.join(map(str, unverified))}." if unverified
+                 else ""))
+    page.table([{"optimum": i + 1, "verified hold (s)": o["verified_hold_time_s"],
+                 "verified peak (N)": o["verified_max_finger_force_N"],
+                 "starts": ", ".join(map(str, o["starts"])), **o["design"]}
+                for i, o in enumerate(multistart["optima"])],
+               "Distinct verified optima, best first", "optima-table")
+    page.table(multistart["starts"], "Every start", "starts-table")
+
+
 def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     """``baseline`` and ``optimum`` are the independent (fine) simulations."""
     page = Page(f"Design: {result['name']}")
@@ -141,6 +176,10 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
                     "Ipopt convergence: the NLP's hold time and its constraint violation")
     if result.get("profile"):
         profile_table(page, result["profile"])
+    if result.get("population"):
+        population_section(page, result["population"])
+    if result.get("multistart"):
+        multistart_section(page, result["multistart"])
     if result.get("pareto"):
         page.section("Hold time against the cap", "pareto")
         page.table(result["pareto"], "Pareto study", "pareto-table")

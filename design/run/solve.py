@@ -15,23 +15,37 @@ phase, Ipopt's function evaluations, peak memory: design/solve/optimize/profile.
 
 from __future__ import annotations
 
+import hashlib
+import pickle
 import time
+from contextlib import nullcontext
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
 from design import __version__
+from design.errors import StudyFailed
 from design.io.design_problem import DesignProblem
 from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.profile import RESULT, SETUP, VERIFICATION, Profile
+from design.solve.optimize.profile import RESULT, SETUP, STUDY, VERIFICATION, Profile
+from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
+                                              starting_designs)
+from design.solve.optimize.population import Member, Population
 from design.solve.optimize.transcription import rule_margins
-from design.solve.optimize.trust_region import Outcome, certify, optimise, verdict, verify
+from design.solve.optimize.trust_region import (CAP_TOLERANCE, Outcome, Scored, caps_text,
+                                                caps_value, certify, optimise,
+                                                population_verdict, verify)
 from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
                                              timed_conveyor)
-from design.study.cases import StudyOptions
+from design.study.cases import FAILED as CASE_FAILED
+from design.study.cases import Case, StudyOptions
+from design.study.cluster import scheduler_address
+from design.study.engine import run_study
+from design.study.progress import StudyProgress
 
 #: a scaled variable this close to 0 or 1 sits on its bound
 ACTIVE = 1e-3
@@ -59,47 +73,233 @@ def design_space(problem: DesignProblem, progress: Progress | None = None) -> De
                                for n, (lo, hi) in problem.variables.items()])
 
 
+def population_of_problem(problem: DesignProblem, space: DesignSpace) -> Population:
+    """The birds the design must hold: the problem's population, each bird
+    in the scene's grasp, or the scene's own bird alone."""
+    spec = problem.population
+    if spec is None:
+        return Population.of(space)
+    return Population(tuple(
+        Member(bird.name, DesignSpace(replace(space.baseline, bird=bird), space.variables), w)
+        for bird, w in zip(spec.birds, spec.weights)), spec.objective)
+
+
 def run(problem: DesignProblem, progress: Progress | None = None,
         study: StudyOptions | None = None) -> RunOutput:
+    """Optimise from every starting design for every cap (Pareto caps chained
+    tightest first within a start), verify, and pick per cap the best
+    verified design; a population also gets its single-bird comparison.
+    The cases run through design/study (``study``: where, and the case
+    store); a study of one chain runs in this process."""
     t0 = time.perf_counter()
     profile = Profile()
     say = progress or (lambda message: None)
     with profile.phase(SETUP):
         space = design_space(problem, progress)
+    population = population_of_problem(problem, space)
     settings = problem.settings
     d0 = space.scale(space.base_values)
-    say("simulating the baseline at 4x the optimiser's resolution")
+    say("simulating the baseline at 4x the optimiser's resolution"
+        + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
-        baseline = verify(space, d0, settings)
-    caps = [c.resolve(baseline.peak) for c in problem.caps]
-    entries, outcomes, start = {}, {}, None
-    # tightest cap first: each design is then feasible for the next, looser
-    # cap and warm-starts it, so the hold time cannot fall as the cap rises
-    for k in sorted(range(len(caps)), key=caps.__getitem__):
-        cap_spec, cap = problem.caps[k], caps[k]
-        say(f"cap {k + 1} of {len(problem.caps)}: {cap:.2f} N ({cap_spec.describe()})")
-        outcome = optimise(space, cap, settings, problem.rules, start, progress)
-        claim = certify(space, outcome, settings, problem.rules, progress)
-        say("verifying at 4x finer resolution")
+        baseline = verify(population, d0, settings)
+    caps = [np.array([c.resolve(peak) for peak in baseline.peaks]) for c in problem.caps]
+    cases = design_cases(problem, space, population, caps)
+    chains = sum(case.after is None for case in cases)
+    options = study or StudyOptions(workers=1)
+    if chains == 1:
+        options = replace(options, workers=1, scheduler=None)
+    local = options.workers == 1 and scheduler_address(options) is None
+    task = partial(solve_case, problem, progress if local and chains == 1 else None)
+    # in this process the cases' own profiles add up to the study's time;
+    # on workers it is one phase of this process
+    with nullcontext() if local else profile.phase(STUDY):
+        results = run_study(cases, task, options=options, label=problem.name,
+                            progress=None if chains == 1 else StudyProgress(quiet=progress is None),
+                            problem_digest=problem_digest(problem))
+    failed = {k: r for k, r in results.items() if r["status"] in CASE_FAILED}
+    if failed:
+        raise StudyFailed("; ".join(f"case {k!r}: {r['status']}: {r.get('message', '')}"
+                                    for k, r in failed.items()))
+    entries, finals = {}, {}
+    for k in range(len(caps)):
+        keys = [case.key for case in cases if case.inputs.get("cap_index") == k]
+        best = max(keys, key=lambda key: _rank(results[key]))
+        entries[k] = dict(results[best], case=best)
+        if problem.multistart.starts > 1:
+            entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
         with profile.phase(VERIFICATION):
-            fine = verify(space, outcome.best.d, settings)
-        with profile.phase(RESULT):
-            entries[k] = _entry(space, problem, outcome, claim, fine, cap, cap_spec)
-        profile.merge(outcome.profile)
-        outcomes[k] = (outcome, fine)
-        start = outcome.best.d
+            finals[k] = _verified(population, best, results[best], settings)
+    for k, entry in entries.items():
+        entry.pop("d")
     with profile.phase(RESULT):
-        output = _output(problem, space, [entries[k] for k in range(len(caps))], outcomes[0],
+        output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
                          baseline, t0)
+    if problem.population:
+        output.result["population"] = population_comparison(
+            space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
+        output.tables["population.csv"] = output.result["population"]["birds"]
+    if problem.multistart.starts > 1:
+        output.tables["starts.csv"] = output.result["multistart"]["starts"]
+    for key in results:
+        if key in _PROFILES:
+            profile.merge(_PROFILES.pop(key))
     output.result["profile"] = profile.summary()
     return output
 
 
-def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], primary_outcome,
-            baseline, t0: float) -> RunOutput:
+#: the study's case for a population's single-bird comparison
+SINGLE_BIRD = "single-bird"
+#: the profiles and fine simulations of the cases this process ran (the
+#: engine returns JSON; the report needs the simulations themselves)
+_PROFILES: dict[str, Profile] = {}
+_FINE: dict[str, Scored] = {}
+
+
+def design_cases(problem: DesignProblem, space: DesignSpace, population: Population,
+                 caps: list[np.ndarray]) -> list[Case]:
+    """Every start's chain of caps, tightest first (each design is feasible
+    for the next, looser cap and warm-starts it, so that the hold cannot fall
+    as the cap rises), and a population's single-bird comparison."""
+    m = problem.multistart
+    starts = starting_designs(space.scale(space.base_values), m.starts, m.seed)
+    cases = []
+    for s, d in enumerate(starts):
+        after = None
+        for k in sorted(range(len(caps)), key=lambda k: caps[k][0]):
+            key = f"start-{s:02d}/cap-{k + 1}" if m.starts > 1 else f"cap-{k + 1}"
+            cases.append(Case(key, {"start": d.tolist(), "start_index": s, "cap_index": k,
+                                    "caps_N": caps[k].tolist()}, after))
+            after = key
+    if problem.population:
+        names = [member.name for member in population.members]
+        own = space.baseline.bird.name
+        cap = caps[0][names.index(own)] if own in names else None
+        cases.append(Case(SINGLE_BIRD, {"single_bird": own, "cap_N": cap}))
+    return cases
+
+
+def solve_case(problem: DesignProblem, progress: Progress | None, case: Case,
+               upstream: dict | None) -> dict:
+    """One case of :func:`design_cases`: the design loop from the case's
+    start (or the upstream cap's optimum), its certification and its 4x
+    finer verification; the result as result.json's entry for a cap, with
+    the scaled design ``d``."""
+    say = progress or (lambda message: None)
+    space = design_space(problem)
+    population = population_of_problem(problem, space)
+    settings = problem.settings
+    if case.key == SINGLE_BIRD:
+        return _single_bird(problem, space, population, case)
+    k = case.inputs["cap_index"]
+    caps = np.array(case.inputs["caps_N"])
+    start = np.array(upstream["d"]) if upstream else np.array(case.inputs["start"])
+    first = upstream is None and case.inputs["start_index"] == 0
+    say(f"cap {k + 1} of {len(problem.caps)}: {caps_text(caps)} "
+        f"({problem.caps[k].describe()})")
+    outcome = optimise(population, caps, settings, problem.rules, None if first else start,
+                       progress, anchor=upstream is not None)
+    certify(population, outcome, settings, problem.rules, progress)
+    say("verifying at 4x finer resolution")
+    with outcome.profile.phase(VERIFICATION):
+        fine = verify(population, outcome.best.d, settings)
+    entry = _entry(space, problem, outcome, fine, problem.caps[k])
+    _PROFILES[case.key], _FINE[case.key] = outcome.profile, fine
+    v = entry["verification"]
+    return {**entry, "d": outcome.best.d.tolist(), "start_index": case.inputs["start_index"],
+            "hold_time_s": v["hold_time_s"],
+            "max_finger_force_N": v["max_finger_force_N"],
+            "verified": entry["status"] == VERIFIED}
+
+
+def _single_bird(problem: DesignProblem, space: DesignSpace, population: Population,
+                 case: Case) -> dict:
+    """The scene's own bird optimised alone at its cap, verified on every bird."""
+    settings = problem.settings
+    own = Population.of(space)
+    cap = case.inputs["cap_N"]
+    if cap is None:
+        cap = problem.caps[0].resolve(verify(own, space.scale(space.base_values), settings).peak)
+    outcome = optimise(own, cap, settings, problem.rules)
+    fine = verify(population, outcome.best.d, settings)
+    _PROFILES[case.key] = outcome.profile
+    return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
+            "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
+            "peaks_N": fine.peaks.tolist(), "hold_time_s": fine.hold}
+
+
+def _rank(result: dict) -> tuple:
+    """Order of a cap's results: verified first, then the longer verified
+    hold; the baseline start's first among the unverified."""
+    return (result["status"] == VERIFIED, result["verification"]["hold_time_s"]
+            if result["status"] == VERIFIED else 0.0)
+
+
+def _verified(population: Population, key: str, result: dict, settings) -> Scored:
+    """The 4x finer simulations of a case's design: the case's own if it
+    ran in this process, else simulated again (deterministic: the same)."""
+    fine = _FINE.pop(key, None)
+    return fine if fine is not None else verify(population, np.array(result["d"]), settings)
+
+
+def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[str],
+                       results: dict) -> dict:
+    """The starts of one cap and the distinct optima they reached
+    (design/solve/optimize/multistart.py says when two are one)."""
+    rows = [{"start": results[key].get("start_index", i), "case": key,
+             "status": results[key]["status"],
+             "verified_hold_time_s": results[key]["verification"]["hold_time_s"],
+             "verified_max_finger_force_N": results[key]["verification"]["max_finger_force_N"],
+             **results[key]["design"]} for i, key in enumerate(keys)]
+    verified = [i for i, key in enumerate(keys) if results[key]["status"] == VERIFIED]
+    groups = distinct_optima([np.asarray(results[keys[i]]["d"]) for i in verified],
+                             [rows[i]["verified_hold_time_s"] for i in verified])
+    optima = sorted(({"verified_hold_time_s": rows[verified[g[0]]]["verified_hold_time_s"],
+                      "verified_max_finger_force_N":
+                          rows[verified[g[0]]]["verified_max_finger_force_N"],
+                      "design": results[keys[verified[g[0]]]]["design"],
+                      "starts": [rows[verified[i]]["start"] for i in g]} for g in groups),
+                    key=lambda o: -o["verified_hold_time_s"])
+    return {"starts": rows, "optima": optima, "seed": problem.multistart.seed,
+            "same_optimum": f"verified designs within {SAME_DESIGN} in every scaled variable "
+                            f"and {100 * SAME_HOLD:g} % in hold, joined transitively",
+            "unverified_starts": [r["start"] for i, r in enumerate(rows) if i not in verified]}
+
+
+def population_comparison(space: DesignSpace, population: Population, baseline: Scored,
+                          single: dict, fine: Scored, caps: np.ndarray) -> dict:
+    """Each bird's hold and peak under the baseline, the single-bird optimum
+    (the scene's own bird alone, at its cap) and the robust optimum, all
+    verified at 4x the optimiser's resolution."""
+    designs = {"baseline": (baseline.holds, baseline.peaks),
+               "single_bird_optimum": (np.array(single["holds_s"]), np.array(single["peaks_N"])),
+               "robust_optimum": (fine.holds, fine.peaks)}
+    rows = [{"bird": member.name, "weight": float(population.weights[b]),
+             "cap_N": float(caps[b]),
+             **{f"{label}_{key}": float(values[i][b]) for label, values in designs.items()
+                for i, key in enumerate(("hold_time_s", "max_finger_force_N"))}}
+            for b, member in enumerate(population.members)]
+    return {"objective": population.aggregate, "single_bird": space.baseline.bird.name,
+            "single_bird_cap_N": single["cap_N"], "single_bird_design": single["design"],
+            "hold_time_s": {label: population.hold(holds)
+                            for label, (holds, _) in designs.items()},
+            "limiting_bird": {label: population.members[int(np.argmin(holds))].name
+                              for label, (holds, _) in designs.items()},
+            "within_caps": {label: bool(np.all(peaks <= caps * (1 + CAP_TOLERANCE)))
+                            for label, (_, peaks) in designs.items()},
+            "birds": rows}
+
+
+def problem_digest(problem: DesignProblem) -> str:
+    """A hash of the parsed problem: a case store belongs to one problem."""
+    return hashlib.sha256(pickle.dumps((problem, __version__))).hexdigest()[:16]
+
+
+def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], fine: Scored,
+            baseline: Scored, t0: float) -> RunOutput:
     """The run's result, tables and files; the first cap's entry is the
-    primary one (its design and verification are reported)."""
-    primary, (outcome, fine) = entries[0], primary_outcome
+    primary one (its design, verified as ``fine``, is reported)."""
+    primary = entries[0]
     status, message = overall_status(entries)
     result = {
         "kind": "design", "name": problem.name, "toolkit_version": __version__,
@@ -125,7 +325,7 @@ def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], pri
         tables["pareto.csv"] = result["pareto"]
     files = {}
     if primary["status"] in (VERIFIED, FAILED):        # else the baseline: no optimum
-        spec = grasp_spec(space.setup(outcome.best.d), problem.scene.settings,
+        spec = grasp_spec(space.setup(fine.d), problem.scene.settings,
                           f"{problem.name}_optimum",
                           f"Optimised by design solve from {problem.name} (cap "
                           f"{primary['verification']['cap_N']:.3g} N).")
@@ -161,17 +361,17 @@ def status_line(result: dict) -> str:
             f"{b['hold_time_s']:.4f} s), {peak}")
 
 
-def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, fine, cap,
+def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: Scored,
            cap_spec) -> dict:
-    best, view = outcome.best, outcome.final
+    best, view, claim = outcome.best, outcome.final, outcome.claim
     claimed, source = claim
-    check = verdict(claimed, fine, cap)
+    check = population_verdict(best.population, outcome.claims, fine, outcome.caps)
     d = best.d
     variables = [{"name": v.name, "unit": v.unit, "lower": v.lo, "upper": v.hi,
                   "baseline": v.baseline, "optimum": v.lo + d[i] * (v.hi - v.lo),
                   "active_bound": "lower" if d[i] < ACTIVE else "upper" if d[i] > 1 - ACTIVE
                   else ""} for i, v in enumerate(space.variables)]
-    status, message = _status(space, problem, outcome, claim, check, fine, variables)
+    status, message = _status(space, problem, outcome, check, fine, variables)
     iterations = outcome.iterations
     return {
         "status": status, "message": message,
@@ -180,7 +380,7 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
         "objective": {"hold_time_s": claimed, "source": source,
                       "grid_step_s": problem.settings.nlp.time_step},
         "verification": check,
-        "cap": {"N": cap, "given_as": cap_spec.describe()},
+        "cap": {"N": caps_value(outcome.caps), "given_as": cap_spec.describe()},
         "rules_broken": [tag for margin, tag in rule_margins(space.values(np.asarray(d, float)),
                                                              space.baseline, problem.rules)
                          if margin < -1e-9],
@@ -208,14 +408,13 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, claim, 
     }
 
 
-def _status(space, problem, outcome: Outcome, claim, check, fine, variables
+def _status(space, problem, outcome: Outcome, check, fine: Scored, variables
             ) -> tuple[str, str]:
     """One cap's status (see the module's docstring) and why."""
-    claimed, source = claim
-    cap = outcome.cap
+    claimed, source = outcome.claim
     errors = outcome.errors
     failures = f" ({len(errors)} NLP failure(s): {'; '.join(errors)})" if errors else ""
-    keeps_cap = check["max_finger_force_N"] <= cap * (1 + check["cap_tolerance"])
+    keeps_cap = fine.within(outcome.caps, check["cap_tolerance"])
     if outcome.every_nlp_failed:
         return ERROR, ("every NLP of the design loop failed, so no design was tried; the "
                        "baseline is unchanged and not an answer: " + "; ".join(errors))
@@ -233,23 +432,27 @@ def _status(space, problem, outcome: Outcome, claim, check, fine, variables
         return ERROR, (f"the optimiser could not evaluate its own design ({source}), so it "
                        f"cannot be verified{failures}")
     if not outcome.feasible:
-        return FAILED, "infeasible: " + _diagnosis(space, problem, outcome.best, cap, variables)
+        return FAILED, "infeasible: " + _diagnosis(space, problem, outcome, variables)
     return FAILED, (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "
-                    f"optimiser's {claimed:.4f} s, peak {fine.peak:.2f} N against the "
-                    f"cap {cap:.2f} N")
+                    f"optimiser's {claimed:.4f} s, peak {check['max_finger_force_N']:.2f} N "
+                    f"against the cap {check['cap_N']:.2f} N")
 
 
-def _diagnosis(space, problem, best, cap, variables) -> str:
+def _diagnosis(space, problem, outcome: Outcome, variables) -> str:
     """Why no design met the cap: the lowest peak reached and what stopped it."""
+    best = outcome.best
+    k = int(np.argmax(best.peaks / outcome.caps))
+    cap, run = outcome.caps[k], best.members[k].run
+    bird = f" on {best.population.members[k].name}" if len(outcome.caps) > 1 else ""
     bounds = [f"{v['name']} at its {v['active_bound']} bound" for v in variables
               if v["active_bound"]]
     values = space.values(np.asarray(best.d, float))
     rules = [tag for margin, tag in rule_margins(values, space.baseline, problem.rules)
              if margin < 1e-6]
     stops = bounds + rules
-    return (f"no design within the bounds keeps every finger under {cap:.2f} N: the smallest "
-            f"peak force reached is {best.peak:.2f} N (finger "
-            f"{best.run.summary['max_finger_force_finger']}); "
+    return (f"no design within the bounds keeps every finger under {cap:.2f} N{bird}: the "
+            f"smallest peak force reached is {best.peaks[k]:.2f} N (finger "
+            f"{run.summary['max_finger_force_finger']}); "
             + ("active: " + ", ".join(stops) if stops else
                "no bound or rule is active: the trust-region loop stopped at a local optimum"))
 

@@ -64,6 +64,8 @@ OPTIMISER, VIEWS = "optimiser NLPs", "fixed-design views"
 CONSTRUCTION, IPOPT, READ_BACK = "construction", "Ipopt", "solution read-back"
 VERIFICATION = "verification simulations (4x finer)"
 RESULT = "result assembly"
+#: a study's cases while they run on Dask workers (their own phases are theirs)
+STUDY = "study cases on workers"
 UNACCOUNTED = "unaccounted"
 PHASES = [SETUP, SIMULATIONS,
           *(f"{group}: {step}" for group in (OPTIMISER, VIEWS)

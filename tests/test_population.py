@@ -1,0 +1,141 @@
+"""Robust design over a population of birds (design/solve/optimize/population.py)
+and the multistart's starts and optima (design/solve/optimize/multistart.py).
+
+The population NLP's invariant: birds that are the same bird under other
+names must give the single bird's NLP solution, whatever the aggregate
+(worst case: all epigraph rows active at one hold; weighted mean of equal
+holds: that hold). Ipopt's path differs (more unknowns, the epigraph
+variable), so the solutions agree to its tolerance, not to the bit: 1e-4
+in the scaled design and 1e-4 s in hold, against the 0.36-0.67 s holds and
+the [0, 1] box of the short grasp (tests/design_cases.py).
+"""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from design.io.scene import load_scene
+from design.errors import ProblemFileError
+from design.solve.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
+from design.solve.optimize.population import Member, Population, PopulationNLP
+from design.solve.optimize.schedule import schedule_of
+from design.solve.optimize.transcription import DesignNLP, NLPSettings
+from design.solve.optimize.trust_region import LoopSettings, simulate
+from tests.design_cases import sharing_simulations, stiffness_space
+
+#: test_design_solve's settings, so that the session shares the simulation
+SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
+NLP = NLPSettings(time_step=0.01, max_iter=60)
+
+
+@pytest.fixture(scope="module")
+def single():
+    space = stiffness_space("lower", "upper")
+    d0 = space.scale(space.base_values)
+    with sharing_simulations():
+        run = simulate(space, d0, SETTINGS).run
+    # a cap and box where the single NLP converges (in 15 iterations): at
+    # tighter caps or wider boxes it stops at its iteration limit, and two
+    # unconverged solves need not agree
+    box = (np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1))
+    result = DesignNLP(space, schedule_of(run, 0.01), run, 18.5, NLP, box=box).solve()
+    return space, run, box, result
+
+
+def test_two_copies_of_a_bird_give_the_single_birds_design(single):
+    space, run, box, alone = single
+    assert alone.success, alone.status
+    population = Population((Member("twin-a", space), Member("twin-b", space)))
+    schedule = schedule_of(run, 0.01)
+    nlp = PopulationNLP(population, [schedule, schedule], [run, run], [18.5, 18.5], NLP,
+                        box=box)
+    both = nlp.solve()
+    assert both.success, both.status
+    assert np.max(np.abs(both.d - alone.d)) < 1e-4
+    assert abs(both.hold_time - alone.hold_time) < 1e-4
+    assert np.allclose(both.peaks, alone.peak_force, rtol=1e-3)
+    # one shared design, each bird's unknowns, the epigraph variable
+    assert nlp.size["members"] == 2 and nlp.size["variables"] == 2 * alone.x.size - 2 + 1
+    # rebound gives each bird its own cap rows
+    caps = nlp.rebound([15.0, 16.0], box).ubg[nlp._cap_rows]
+    per_bird = int(np.sum(nlp.nlps[0]._cap_rows))
+    assert np.all(caps[:per_bird] == 15.0) and np.all(caps[per_bird:] == 16.0)
+
+
+def test_a_population_aggregates_its_holds():
+    space = stiffness_space("upper")
+    worst = Population((Member("a", space, 1.0), Member("b", space, 3.0)))
+    mean = replace(worst, aggregate="mean")
+    assert worst.hold([0.3, 0.5]) == 0.3
+    assert mean.hold([0.3, 0.5]) == pytest.approx(0.25 * 0.3 + 0.75 * 0.5)
+    assert Population.of(space).members[0].name == space.baseline.bird.name
+
+
+def test_starting_designs_are_reproducible_and_fill_the_box():
+    base = np.array([0.5, 0.2, 0.9])
+    a, b = starting_designs(base, 8, 7), starting_designs(base, 8, 7)
+    assert len(a) == 8 and np.array_equal(a[0], base)
+    assert all(np.array_equal(x, y) for x, y in zip(a, b))
+    points = np.array(a[1:])
+    assert points.min() >= 0 and points.max() <= 1
+    # scrambled Sobol (a (t, m, s)-net): every coordinate's halves hold 4 points each
+    full = np.array(starting_designs(base, 9, 7)[1:])
+    assert all(np.sum(full[:, j] < 0.5) == 4 for j in range(3))
+    assert not np.array_equal(starting_designs(base, 8, 8)[1], a[1])
+    assert len(starting_designs(base, 1, 0)) == 1
+
+
+def test_optima_join_when_near_in_design_and_hold():
+    e = SAME_DESIGN
+    designs = [np.array([0.0, 0.0]), np.array([0.8 * e, 0.0]), np.array([1.6 * e, 0.0]),
+               np.array([0.5, 0.5]), np.array([0.5, 0.5])]
+    holds = [0.30, 0.301, 0.302, 0.40, 0.30]
+    # 0-1-2 chain (each step within e, the ends 1.6 e apart); 3 and 4 share a
+    # design but not a hold
+    assert distinct_optima(designs, holds) == [[0, 1, 2], [3], [4]]
+
+
+def test_population_input_errors_name_the_field(tmp_path):
+    base = {"kind": "design", "scene": "problems/grasp_mean_bird_hard.yaml",
+            "variables": {"groups.upper.stiffness_scale": [0.5, 2.0]}}
+    bird = "models/birds/small_1_20kg.yaml"
+    cases = [
+        ({"birds": []}, "population.birds: expected a non-empty list"),
+        ({"birds": [bird], "objective": "median"}, "population.objective"),
+        ({"birds": [{"bird": bird, "weight": 0}]}, "population.birds[0].weight"),
+        ({"birds": [bird, bird]}, "listed twice"),
+        ({"birds": ["models/birds/no_such_bird.yaml"]}, "population.birds[0]"),
+    ]
+    for population, message in cases:
+        with pytest.raises(ProblemFileError) as info:
+            load_scene({**base, "population": population})
+        assert message in str(info.value), (population, str(info.value))
+    problem = load_scene({**base, "population": {"birds": [bird, {
+        "bird": "models/birds/large_2_30kg.yaml", "weight": 2}]},
+        "multistart": {"starts": 4, "seed": 3}})
+    assert [b.mass for b in problem.population.birds] == [1.2, 2.3]
+    assert problem.population.weights == (1.0, 2.0) and problem.population.objective == "worst"
+    assert (problem.multistart.starts, problem.multistart.seed) == (4, 3)
+
+
+def test_a_multistart_lists_its_distinct_optima_and_takes_the_best_verified():
+    from design.io.design_problem import MultistartSpec
+    from design.run.solve import _rank, multistart_summary
+
+    def result(start, status, hold, d):
+        return {"status": status, "start_index": start, "d": d,
+                "design": {"groups.upper.stiffness_scale": 0.5 + d[0]},
+                "verification": {"hold_time_s": hold, "max_finger_force_N": 20.0 + start}}
+
+    results = {"s0": result(0, "verified", 0.30, [0.10]),
+               "s1": result(1, "verified", 0.35, [0.70]),
+               "s2": result(2, "verified", 0.351, [0.72]),
+               "s3": result(3, "failed verification", 0.50, [0.40])}
+    problem = type("P", (), {"multistart": MultistartSpec(4, 5)})()
+    summary = multistart_summary(problem, None, list(results), results)
+    assert [o["starts"] for o in summary["optima"]] == [[1, 2], [0]]     # best first
+    assert summary["optima"][0]["verified_hold_time_s"] == 0.35
+    assert summary["unverified_starts"] == [3] and summary["seed"] == 5
+    # an unverified longer hold never wins over a verified one
+    assert max(results, key=lambda k: _rank(results[k])) == "s2"
