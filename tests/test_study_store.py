@@ -69,16 +69,27 @@ def test_the_store_has_the_documented_tables_in_wal_mode(tmp_path):
     assert 0 <= age.total_seconds() < 60
 
 
-def test_an_earlier_runs_store_is_refused_without_resume(tmp_path):
+def test_an_unfinished_store_is_refused_without_resume(tmp_path):
     store = tmp_path / "cases.sqlite"
-    run(store)
+    failing = [CASES[0], Case("b", {"x": 2, "fail": True}, after="a")]
+    run(store, cases=failing)                       # b fails: the study is not completed
     before = [row["finished_at"] for row in read_cases(store)]
     with pytest.raises(StudyError) as refused:
         run(store)
     assert str(store) in str(refused.value) and "--resume" in str(refused.value)
-    assert "delete the file" in str(refused.value)
+    assert "unfinished" in str(refused.value) and "delete the file" in str(refused.value)
     assert [row["finished_at"] for row in read_cases(store)] == before
     assert called(tmp_path / "calls") == ["a", "b"]
+
+
+def test_a_completed_store_is_started_again_without_resume(tmp_path):
+    store = tmp_path / "cases.sqlite"
+    run(store)
+    run(store)                                      # a new run replaces a completed study
+    assert called(tmp_path / "calls") == ["a", "a", "b", "b"]
+    assert [row["key"] for row in read_cases(store)] == ["a", "b"]
+    run(store, resume=True)                         # resumed: nothing runs again
+    assert len(called(tmp_path / "calls")) == 4
 
 
 def test_another_problems_store_is_refused_on_resume(tmp_path):

@@ -110,6 +110,8 @@ def run_study(cases: list[Case], task: Task, *, options: StudyOptions, label: st
             _run_serial(todo, task, results, finish)
         else:
             _run_dask(todo, task, options, results, finish, started)
+        if store is not None and not any(r["status"] in FAILED for r in results.values()):
+            store.complete()
     finally:
         if store is not None:
             store.close()

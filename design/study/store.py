@@ -9,7 +9,8 @@ writes)::
           problem_digest TEXT,   -- the caller's digest of the problem the cases belong to
           label TEXT,            -- the study's name in progress lines
           version TEXT,          -- design.__version__ that created the store
-          created_at TEXT)       -- UTC, ISO 8601
+          created_at TEXT,       -- UTC, ISO 8601
+          completed_at TEXT)     -- UTC, when every case finished without error; NULL before
     cases(key TEXT PRIMARY KEY,
           inputs TEXT,           -- the case's inputs, canonical JSON
           after TEXT,            -- the key of the case it warm-starts from, or NULL
@@ -23,7 +24,10 @@ Only the process that coordinates the study writes (one writer; the
 workers return their results to it). A stored case is reused only when its
 key, inputs and ``after`` are the current ones and its status is neither
 ``error`` nor ``skipped``; a store whose problem digest is not the current
-one is refused (:class:`~design.errors.StudyError`), never reused.
+one is refused (:class:`~design.errors.StudyError`), never reused. Without
+``resume``, a completed study's store is started again (like the run's
+other files, a new run replaces it) and an unfinished one (stopped, or
+with failed cases) is refused: its finished cases may be hours of work.
 """
 
 from __future__ import annotations
@@ -43,7 +47,7 @@ STORE = "cases.sqlite"
 SCHEMA = """
 CREATE TABLE IF NOT EXISTS study (id INTEGER PRIMARY KEY CHECK (id = 1),
     problem_digest TEXT NOT NULL, label TEXT NOT NULL, version TEXT NOT NULL,
-    created_at TEXT NOT NULL);
+    created_at TEXT NOT NULL, completed_at TEXT);
 CREATE TABLE IF NOT EXISTS cases (key TEXT PRIMARY KEY, inputs TEXT NOT NULL, after TEXT,
     result TEXT NOT NULL, status TEXT NOT NULL, wall_time_s REAL, worker TEXT,
     finished_at TEXT NOT NULL);
@@ -83,6 +87,11 @@ class CaseStore:
                               result["status"], result.get("wall_time_s"),
                               result.get("worker"), utc_now()))
 
+    def complete(self) -> None:
+        """Mark the study completed: every case finished without error."""
+        with self._db:
+            self._db.execute("UPDATE study SET completed_at = ?", (utc_now(),))
+
     def close(self) -> None:
         self._db.close()
 
@@ -98,6 +107,10 @@ def open_store(path: Path, problem_digest: str, label: str, resume: bool) -> Cas
     db = _connect(path)
     try:
         count = _count(db, path, resume)
+        if count and not resume:                 # a completed study: start again
+            with db:
+                db.execute("DELETE FROM cases")
+            count = 0
         stored = db.execute("SELECT problem_digest FROM study").fetchone()
         if count and stored[0] != problem_digest:
             raise StudyError(f"{path}: the problem changed since its cases were computed "
@@ -105,7 +118,7 @@ def open_store(path: Path, problem_digest: str, label: str, resume: bool) -> Cas
                              f"now); delete the file, or choose another output folder")
         if not count:
             with db:
-                db.execute("INSERT OR REPLACE INTO study VALUES (1, ?, ?, ?, ?)",
+                db.execute("INSERT OR REPLACE INTO study VALUES (1, ?, ?, ?, ?, NULL)",
                            (problem_digest, label, __version__, utc_now()))
     except BaseException:
         db.close()
@@ -115,8 +128,9 @@ def open_store(path: Path, problem_digest: str, label: str, resume: bool) -> Cas
 
 def check_store(path: Path, resume: bool) -> None:
     """Refuse, before a run starts, a store at ``path`` that :func:`open_store`
-    would refuse whatever the problem (not a case store; cases and no
-    ``resume``). A missing file is fine (it is not made here)."""
+    would refuse whatever the problem (not a case store; an unfinished
+    study's cases and no ``resume``). A missing file is fine (it is not
+    made here)."""
     path = Path(path)
     if path.is_file():
         db = _connect(path)
@@ -127,11 +141,13 @@ def check_store(path: Path, resume: bool) -> None:
 
 
 def _count(db: sqlite3.Connection, path: Path, resume: bool) -> int:
-    """The number of stored cases; StudyError if there are some and ``resume`` is false."""
+    """The number of stored cases; StudyError if there are some, the study
+    is not completed and ``resume`` is false."""
     count = db.execute("SELECT count(*) FROM cases").fetchone()[0]
-    if count and not resume:
+    completed = db.execute("SELECT completed_at FROM study").fetchone()
+    if count and not resume and not (completed and completed[0]):
         raise StudyError(f"{path} already holds {count} case{'s' if count != 1 else ''} "
-                         f"of an earlier run; pass --resume (resume=True) to reuse them, "
+                         f"of an unfinished earlier run; pass --resume (resume=True) to reuse them, "
                          f"or delete the file to start again")
     return count
 
