@@ -1,6 +1,9 @@
 """Collocation sweeps: the condensed Newton step is the full system's, the
-compiled sweep computes what the interpreted one does, and a chain that
-runs out of Newton steps hands its loads to the one-by-one solve."""
+compiled sweep computes what the interpreted one does, a chain that runs
+out of Newton steps hands its loads to the one-by-one solve, and a sweep's
+shape table is every case's every point."""
+
+from pathlib import Path
 
 import casadi as ca
 import numpy as np
@@ -12,6 +15,8 @@ from design.solve import compiled as comp
 from design.solve.beam import collocation, solve_beam, sweep
 from design.solve.beam.collocation import BeamTranscription
 from tests.problems import table_2_3, thesis_finger, tip_distance
+
+ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.mark.parametrize("stiffness", [thesis_finger().stiffness, UniformEI(0.08)])
@@ -67,3 +72,22 @@ def test_a_chain_out_of_newton_steps_leaves_its_loads_to_single_solves(fresh, mo
     assert any(s.iterations > 1 for s in redone)   # solved one by one, from the seed
     for a, b in zip(chained, redone):
         assert tip_distance(a, b) <= a.error_estimate + b.error_estimate
+
+
+def test_a_sweeps_shape_table_has_every_case_and_point():
+    """shapes.csv's rows are made when read: the same rows, in order, as
+    the result's shapes, each finger run on to its free end."""
+    import design
+    from design.run.beam import ShapeRows
+
+    finger = ROOT / "models" / "fingers" / "thesis_nonuniform_soft.yaml"
+    result = design.simulate({"kind": "beam", "finger": str(finger),
+                              "load": {"F": [0, 5, 10, 15, 20], "alpha": "60 deg", "at": 0.1}})
+    rows = ShapeRows(result["cases"])
+    expected = [{"case": i, "s_m": s, "x_m": x, "y_m": y, "psi_rad": p, "M_N_m": m}
+                for i, c in enumerate(result["cases"])
+                for s, x, y, p, m in zip(*(c["shape"][k] for k in ("s", "x", "y", "psi", "M")))]
+    assert len(rows) == len(expected) and list(rows) == expected
+    assert [rows[i] for i in (0, 7, -1)] == [expected[i] for i in (0, 7, -1)]
+    assert all(c["shape"]["s"][-1] == 0.203 and c["shape"]["s"].size == c["shape"]["x"].size
+               for c in result["cases"])
