@@ -126,6 +126,8 @@ def run(problem: DesignProblem, progress: Progress | None = None,
         keys = [case.key for case in cases if case.inputs.get("cap_index") == k]
         best = max(keys, key=lambda key: _rank(results[key]))
         entries[k] = dict(results[best], case=best)
+        if entries[k]["status"] == NO_DESIGN:
+            entries[k]["status"] = ERROR
         if problem.multistart.starts > 1:
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
         with profile.phase(VERIFICATION):
@@ -148,6 +150,8 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     return output
 
 
+#: a case's status when its design loop ended in ERROR
+NO_DESIGN = "no design (optimiser error)"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
 #: the profiles and fine simulations of the cases this process ran (the
@@ -206,7 +210,11 @@ def solve_case(problem: DesignProblem, progress: Progress | None, case: Case,
     entry = _entry(space, problem, outcome, fine, problem.caps[k])
     _PROFILES[case.key], _FINE[case.key] = outcome.profile, fine
     v = entry["verification"]
-    return {**entry, "d": outcome.best.d.tolist(), "start_index": case.inputs["start_index"],
+    # a loop that could not work from this start is an answer, not a failed
+    # case (the study engine's "error": the computation raised)
+    status = NO_DESIGN if entry["status"] == ERROR else entry["status"]
+    return {**entry, "status": status, "d": outcome.best.d.tolist(),
+            "start_index": case.inputs["start_index"],
             "hold_time_s": v["hold_time_s"],
             "max_finger_force_N": v["max_finger_force_N"],
             "verified": entry["status"] == VERIFIED}
