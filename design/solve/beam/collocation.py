@@ -353,8 +353,8 @@ class Collocation(IterativeMethod):
         P[0], P[1], P[2], P[3] = padded, alpha, at, ei_ref
         P[4:4 + tr.K] = widths[:, None]
         P[4 + tr.K:] = self.finger.stiffness.params[:, None]
-        A0 = np.stack([np.concatenate([w, w, [padded[j], padded[j]]])
-                       for w, j in zip((tr.guess(sd, ei_ref, widths) for sd in seeds), starts)], 1)
+        A0 = np.stack([sweep.start(tr.guess(sd, ei_ref, widths), padded[j])
+                       for sd, j in zip(seeds, starts)], 1)
         S = evaluate(sweep.chain(per, parts), A0, P)[1]
         return S[:-1, :n], S[-1, :n], P[:, :n]
 

@@ -14,6 +14,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 import casadi as ca
+import numpy as np
 
 from design.solve.compiled import compiled
 
@@ -45,10 +46,12 @@ class SweepFunctions:
     """One transcription's sweep functions at a Newton tolerance, compiled or not.
 
     ``step``: (acc, P) -> (acc', [w; steps]), one solve of a continuation run;
-    acc = [w1; w2; F1; F2] holds the run's last two solutions and their
-    forces, the start is their linear extrapolation in F (a secant
-    predictor: one Newton step instead of two, measured), and plain Newton
-    steps (no line search) follow until max |G| ≤ ``tolerance`` or
+    acc = [w1; w2; w3; F1; F2; F3] holds the run's last three solutions and
+    their forces (:meth:`start`: a run's first), the start is their quadratic
+    extrapolation in F (linear, or the last solution, while the run has
+    fewer distinct forces): one Newton step on a 1000-load sweep where the
+    secant predictor took two for half the loads at 60° (measured). Plain
+    Newton steps (no line search) follow until max |G| ≤ ``tolerance`` or
     :data:`MAX_STEPS` of them: the start is close, and a solve that fails
     anyway is redone by the caller. ``shape_check``, ``tip_check``: the
     transcription's.
@@ -57,18 +60,24 @@ class SweepFunctions:
     def __init__(self, tr: BeamTranscription, tolerance: float, compile: bool):
         self.tr, self.tolerance = tr, tolerance
         nw = tr.n_w
-        acc = ca.MX.sym("acc", 2 * nw + 2)
+        acc = ca.MX.sym("acc", 3 * nw + 3)
         P = ca.MX.sym("P", tr.n_p)
-        w1, w2, f1, f2 = acc[:nw], acc[nw:2 * nw], acc[2 * nw], acc[2 * nw + 1]
-        slope = ca.if_else(ca.fabs(f1 - f2) > 0, (P[0] - f1) / (f1 - f2), 0)
-        solved = self._newton(w1 + slope * (w1 - w2), P, MAX_STEPS)
+        w = [acc[i * nw:(i + 1) * nw] for i in range(3)]
+        f = [acc[3 * nw + i] for i in range(3)]
+        weights = extrapolation(P[0], *f)
+        solved = self._newton(sum(a * wi for a, wi in zip(weights, w)), P, MAX_STEPS)
         step = ca.Function("beam_continuation_step", [acc, P],
-                           [ca.vertcat(solved[:nw], w1, P[0], f1), solved])
+                           [ca.vertcat(solved[:nw], w[0], w[1], P[0], f[0], f[1]), solved])
         functions = [step, tr.shape_check, tr.tip_check]
         done = compiled(functions) if compile else None
         self.compiled = done is not None and done.compiled
         self.step, self.shape_check, self.tip_check = done.functions if done else functions
         self._cache: dict[tuple, ca.Function] = {}
+
+    @staticmethod
+    def start(w: np.ndarray, force: float) -> np.ndarray:
+        """acc of a run that starts from ``w`` at ``force``."""
+        return np.concatenate([w, w, w, [force] * 3])
 
     def _newton(self, w: ca.MX, P: ca.MX, steps: int) -> ca.MX:
         """[w; steps taken] after Newton steps from w, at least one, until
@@ -84,9 +93,9 @@ class SweepFunctions:
 
     def chain(self, n: int, parts: int = 1) -> ca.Function:
         """``parts`` continuation runs of n solves each, in parallel threads:
-        (A0[2 n_w + 2 x parts], P[n_p x n parts]) -> (acc, S[n_w + 1 x n parts]),
+        (A0[3 n_w + 3 x parts], P[n_p x n parts]) -> (acc, S[n_w + 1 x n parts]),
         S holding each solve's unknowns and the Newton steps it took; A0 holds
-        each run's start, [w; w; F; F]."""
+        each run's :meth:`start`."""
         key = ("chain", n, parts)
         if key not in self._cache:
             run = self.step.mapaccum("beam_run", n, [0], [0])
@@ -99,3 +108,17 @@ class SweepFunctions:
         if key not in self._cache:
             self._cache[key] = getattr(self, name).map(n)
         return self._cache[key]
+
+
+def extrapolation(force: ca.MX, f1: ca.MX, f2: ca.MX, f3: ca.MX) -> tuple[ca.MX, ca.MX, ca.MX]:
+    """Weights of the last three solutions (at forces f1, f2, f3) that
+    extrapolate them to ``force``: quadratic (Lagrange) when the three
+    forces differ, linear in the last two when those differ, else the last."""
+    quadratic = ca.logic_and(ca.logic_and(f1 != f2, f2 != f3), f1 != f3)
+    linear = f1 != f2
+    lagrange = [(force - fb) * (force - fc) / ((fa - fb) * (fa - fc))
+                for fa, fb, fc in ((f1, f2, f3), (f2, f1, f3), (f3, f1, f2))]
+    secant = [(force - f2) / (f1 - f2), (force - f1) / (f2 - f1)]
+    return (ca.if_else(quadratic, lagrange[0], ca.if_else(linear, secant[0], 1)),
+            ca.if_else(quadratic, lagrange[1], ca.if_else(linear, secant[1], 0)),
+            ca.if_else(quadratic, lagrange[2], 0))
