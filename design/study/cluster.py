@@ -74,7 +74,12 @@ def dask_client(options: StudyOptions, cases: int) -> Iterator[tuple[object, str
             cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                    dashboard_address=None, silence_logs=logging.ERROR,
                                    env=WORKER_ENV, preload=[__name__],
-                                   scheduler_kwargs={"allowed_failures": ALLOWED_FAILURES})
+                                   # the scheduler's HTTP server (health, metrics)
+                                   # starts even without a dashboard, on 8787 unless
+                                   # told otherwise: a second study warned of the port
+                                   scheduler_kwargs={"allowed_failures": ALLOWED_FAILURES,
+                                                     "dashboard": False,
+                                                     "dashboard_address": ":0"})
             client = Client(cluster)
         try:
             if address:
