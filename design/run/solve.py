@@ -424,8 +424,9 @@ def _status(space, problem, outcome: Outcome, check, fine: Scored, variables
     failures = f" ({len(errors)} NLP failure(s): {'; '.join(errors)})" if errors else ""
     keeps_cap = fine.within(outcome.caps, check["cap_tolerance"])
     if outcome.every_nlp_failed:
+        start = "baseline" if outcome.best is outcome.baseline else "starting design"
         return ERROR, ("every NLP of the design loop failed, so no design was tried; the "
-                       "baseline is unchanged and not an answer: " + "; ".join(errors))
+                       f"{start} is unchanged and not an answer: " + "; ".join(errors))
     if outcome.best is outcome.baseline and keeps_cap:
         return NO_IMPROVEMENT, ("the design loop found no design that holds longer under "
                                 "the cap; the design reported is the baseline, unchanged"
