@@ -2,11 +2,15 @@
 
 A sweep (many loads of one direction and position) is solved by
 :class:`SweepFunctions` of one transcription: continuation runs inside
-CasADi, each load started from the previous two solutions and finished by
-condensed Newton steps (:attr:`BeamTranscription.newton_step`), then the
-shape (or load point) and the residual of every load in one mapped call.
-Large sweeps on meshes no finer than the default run them compiled
-(design/solve/compiled.py, :func:`worth_compiling`), others interpreted.
+CasADi, each load started from the previous solutions and finished by
+Newton steps, then the shape (or load point) and the residual of every
+load in one mapped call. Large sweeps on meshes no finer than the default
+run them compiled (design/solve/compiled.py, :func:`worth_compiling`), with
+condensed Newton steps (:attr:`BeamTranscription.newton_step`); others run
+interpreted, with a sparse QR factorisation of the whole Jacobian instead,
+which CasADi's virtual machine runs faster than the condensed step's many
+scalar operations (40 against 60 µs at 16 intervals, 151 against 233 at 64,
+measured; compiled, the condensed step takes 9 µs).
 """
 
 from __future__ import annotations
@@ -16,24 +20,22 @@ from typing import TYPE_CHECKING
 import casadi as ca
 import numpy as np
 
-from design.solve.compiled import compiled
+from design.solve.compiled import compiled, compiler
 
 if TYPE_CHECKING:
     from design.solve.beam.collocation import BeamTranscription
 
-#: Newton steps a chained solve takes at most: from the secant predictor one
-#: or two on a 1000-load sweep, three or four on a 13-load one (measured);
-#: every step is a level of nested conditionals in the compiled library (50
-#: levels took 3.5 s more compiler time than 10)
-MAX_STEPS = 10
+#: Newton steps a chained solve takes at most (a rootfinder's default; one
+#: on a 1000-load sweep, two to four on a 13-load one, measured)
+MAX_STEPS = 50
 #: sweeps of at least this many loads use compiled functions: building them
 #: takes seconds (once per machine: the libraries are cached), a smaller
 #: sweep milliseconds interpreted
 COMPILE_MIN_LOADS = 100
 #: ... on meshes of at most this many unknowns (16 intervals of degree 4, the
 #: default): the compiler's time grows faster than the mesh (fine and coarse
-#: library, measured: 8 s at 16 intervals, 38 s at 32), and at 32 intervals
-#: it saves 0.4 s per 1000 loads (0.09 s compiled, 0.49 s interpreted)
+#: library, measured: 2.5 s at 16 intervals, 25 s at 32), and at 32 intervals
+#: it saves 0.18 s per 1000 loads (0.07 s compiled, 0.25 s interpreted)
 COMPILE_MAX_UNKNOWNS = 160
 
 
@@ -51,10 +53,10 @@ class SweepFunctions:
     extrapolation in F (linear, or the last solution, while the run has
     fewer distinct forces): one Newton step on a 1000-load sweep where the
     secant predictor took two for half the loads at 60° (measured). Plain
-    Newton steps (no line search) follow until max |G| ≤ ``tolerance`` or
-    :data:`MAX_STEPS` of them: the start is close, and a solve that fails
-    anyway is redone by the caller. ``shape_check``, ``tip_check``: the
-    transcription's.
+    Newton steps (no line search; condensed when compiled, by sparse QR
+    otherwise) follow until max |G| ≤ ``tolerance`` or :data:`MAX_STEPS` of
+    them: the start is close, and a solve that fails anyway is redone by the
+    caller. ``shape_check``, ``tip_check``: the transcription's.
     """
 
     def __init__(self, tr: BeamTranscription, tolerance: float, compile: bool):
@@ -65,13 +67,14 @@ class SweepFunctions:
         w = [acc[i * nw:(i + 1) * nw] for i in range(3)]
         f = [acc[3 * nw + i] for i in range(3)]
         weights = extrapolation(P[0], *f)
-        solved = self._newton(sum(a * wi for a, wi in zip(weights, w)), P, MAX_STEPS)
+        compile = compile and compiler()[0] is not None
+        self._newton_step = tr.newton_step if compile else sparse_newton_step(tr)
+        solved = self._newton(MAX_STEPS)(sum(a * wi for a, wi in zip(weights, w)), P)
         step = ca.Function("beam_continuation_step", [acc, P],
                            [ca.vertcat(solved[:nw], w[0], w[1], P[0], f[0], f[1]), solved])
         functions = [step, tr.shape_check, tr.tip_check]
-        done = compiled(functions) if compile else None
-        self.compiled = done is not None and done.compiled
-        self.step, self.shape_check, self.tip_check = done.functions if done else functions
+        self.step, self.shape_check, self.tip_check = \
+            compiled(functions).functions if compile else functions
         self._cache: dict[tuple, ca.Function] = {}
 
     @staticmethod
@@ -79,17 +82,23 @@ class SweepFunctions:
         """acc of a run that starts from ``w`` at ``force``."""
         return np.concatenate([w, w, w, [force] * 3])
 
-    def _newton(self, w: ca.MX, P: ca.MX, steps: int) -> ca.MX:
-        """[w; steps taken] after Newton steps from w, at least one, until
-        max |G| ≤ the tolerance or ``steps`` of them (each further step is
-        evaluated only when needed)."""
+    def _newton(self, steps: int) -> ca.Function:
+        """(w, P) -> [w; steps taken] after Newton steps from w, at least one,
+        until max |G| ≤ the tolerance or ``steps`` of them. Each further step
+        is a branch of a switch on the iterate, evaluated only when needed
+        (an MX ``if_else`` would make its branches functions of the run's
+        inputs and compute every earlier step again)."""
         tr = self.tr
-        w = tr.newton_step(w, P)
-        done = ca.vertcat(w, 1)
-        if steps == 1:
-            return done
-        more = self._newton(w, P, steps - 1) + ca.vertcat(ca.MX(tr.n_w, 1), 1)
-        return ca.if_else(tr.residual_norm(w, P) > self.tolerance, more, done, True)
+        w, P = ca.MX.sym("w", tr.n_w), ca.MX.sym("P", tr.n_p)
+        after = self._newton_step(w, P)
+        if steps > 1:
+            done = ca.Function("beam_newton_done", [w, P], [ca.vertcat(w, 1)])
+            more = ca.Function("beam_newton_more", [w, P],
+                               [self._newton(steps - 1)(w, P) + ca.vertcat(ca.MX(tr.n_w, 1), 1)])
+            branch = ca.Function.if_else(f"beam_newton_{steps}", more, done)
+            return ca.Function(f"beam_newton_from_{steps}", [w, P],
+                               [branch(tr.residual_norm(after, P) > self.tolerance, after, P)])
+        return ca.Function("beam_newton_from_1", [w, P], [ca.vertcat(after, 1)])
 
     def chain(self, n: int, parts: int = 1) -> ca.Function:
         """``parts`` continuation runs of n solves each, in parallel threads:
@@ -122,3 +131,15 @@ def extrapolation(force: ca.MX, f1: ca.MX, f2: ca.MX, f3: ca.MX) -> tuple[ca.MX,
     return (ca.if_else(quadratic, lagrange[0], ca.if_else(linear, secant[0], 1)),
             ca.if_else(quadratic, lagrange[1], ca.if_else(linear, secant[1], 0)),
             ca.if_else(quadratic, lagrange[2], 0))
+
+
+def sparse_newton_step(tr: BeamTranscription) -> ca.Function:
+    """(w, P) -> w after one Newton step, by a sparse QR factorisation of
+    the residual's whole Jacobian: the same step as the condensed one (to
+    rounding, tests/test_beam_sweep.py), faster interpreted."""
+    w, P = ca.SX.sym("w", tr.n_w), ca.SX.sym("P", tr.n_p)
+    G = tr.residual(w, P)
+    jacobian = ca.Function("beam_residual_jacobian", [w, P], [ca.jacobian(G, w), G])
+    w, P = ca.MX.sym("w", tr.n_w), ca.MX.sym("P", tr.n_p)
+    J, G = jacobian(w, P)
+    return ca.Function("beam_sparse_newton_step", [w, P], [w - ca.solve(J, G, "qr")])
