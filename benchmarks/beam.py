@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import platform
 import time
 from pathlib import Path
@@ -48,13 +49,13 @@ CASES = {
 BVP_TOLS = [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
 
 
-def bvp_sweep(finger: Finger, loads: list[PointLoad], tol: float) -> tuple[np.ndarray, bool]:
+def bvp_sweep(finger: Finger, loads: list[PointLoad], tol: float) -> tuple[np.ndarray, np.ndarray]:
     """solve_bvp on the first-order elastica (x, y, ψ, M), warm-started along
-    the sweep: load points (n, 2), and whether every solve converged."""
+    the sweep: load points (n, 2), and each solve's status (0: converged)."""
     stiff = finger.stiffness
     guess_s = np.linspace(0.0, 1.0, 11)
     y_prev = None
-    out, converged = [], True
+    out, status = [], []
     for load in loads:
         L = load.at
         fx, fy = load.components
@@ -70,10 +71,10 @@ def bvp_sweep(finger: Finger, loads: list[PointLoad], tol: float) -> tuple[np.nd
             x_prev, y_prev = guess_s, np.zeros((4, guess_s.size))
             y_prev[0] = guess_s * L
         sol = solve_bvp(rhs, bc, x_prev, y_prev, tol=tol, max_nodes=100000)
-        converged &= sol.status == 0
+        status.append(sol.status)
         x_prev, y_prev = sol.x, sol.y
         out.append(sol.y[:2, -1])
-    return np.array(out), bool(converged)
+    return np.array(out), np.array(status)
 
 
 def sweep_twice(fn) -> tuple[object, float, float]:
@@ -87,6 +88,7 @@ def sweep_twice(fn) -> tuple[object, float, float]:
 
 
 def run(quick: bool) -> dict:
+    load_average = os.getloadavg()
     repeat = 3 if quick else 7
     rows = []
     for case, (finger, load) in CASES.items():
@@ -105,12 +107,12 @@ def run(quick: bool) -> dict:
                              "time_per_solve_s": dt, "first_call_s": first,
                              "converged": bool(sols[0].converged)})
         for tol in BVP_TOLS:
-            (got, ok), dt, first = timed(lambda: bvp_sweep(finger, [load], tol), repeat,
-                                         warmup=True)
+            (got, status), dt, first = timed(lambda: bvp_sweep(finger, [load], tol), repeat,
+                                             warmup=True)
             rows.append({"case": case, "method": "scipy solve_bvp", "resolution": f"tol={tol:g}",
                          "default": False, "tip_error_m": float(np.linalg.norm(got[0] - ref)),
                          "error_estimate_m": None, "time_per_solve_s": dt, "first_call_s": first,
-                         "converged": ok})
+                         "converged": bool((status == 0).all())})
 
     # the sweep, through the public API
     n = 200 if quick else 1000
@@ -132,11 +134,11 @@ def run(quick: bool) -> dict:
                           "first_sweep_per_solve_s": first / n,
                           "all_converged": all(s.converged for s in sols)})
     for tol in BVP_TOLS:
-        (got, ok), dt, first = sweep_twice(lambda: bvp_sweep(finger, loads, tol))
+        (got, status), dt, first = sweep_twice(lambda: bvp_sweep(finger, loads, tol))
         sweep.append({"method": "scipy solve_bvp", "resolution": f"tol={tol:g}", "default": False,
                       "max_tip_error_m": float(np.linalg.norm(got - ref, axis=1).max()),
                       "time_per_solve_s": dt / n, "first_sweep_per_solve_s": first / n,
-                      "all_converged": ok})
+                      "all_converged": bool((status == 0).all())})
 
     # Frisch-Fay vectorised sweep: uniform EI = 0.08, same loads
     uni = Finger(0.203, UniformEI(0.08))
@@ -178,7 +180,8 @@ def run(quick: bool) -> dict:
     default_colloc = next(r for r in sweep if r["method"] == "collocation" and r["default"])
     return {
         "machine": {"python": platform.python_version(), "processor": platform.processor(),
-                    "cores": __import__("os").cpu_count()},
+                    "cores": os.cpu_count(), "load_average_at_start": load_average,
+                    "load_average_at_end": os.getloadavg()},
         "quick": quick, "sweep_loads": n,
         "timing": "warm against warm: the first call of every method and setting (CasADi "
                   "functions built) is reported apart as first_call_s / "
