@@ -33,9 +33,10 @@ MAX_STEPS = 50
 #: sweep milliseconds interpreted
 COMPILE_MIN_LOADS = 100
 #: ... on meshes of at most this many unknowns (16 intervals of degree 4, the
-#: default): the compiler's time grows faster than the mesh (fine and coarse
-#: library, measured: 2.5 s at 16 intervals, 25 s at 32), and at 32 intervals
-#: it saves 0.18 s per 1000 loads (0.07 s compiled, 0.25 s interpreted)
+#: default): the compiler's time grows faster than the mesh (measured: 3 s
+#: for the 8-interval library, 6.5 s for 16, 18 s for 32), and at 32
+#: intervals it saves 0.18 s per 1000 loads (0.07 s compiled, 0.25 s
+#: interpreted)
 COMPILE_MAX_UNKNOWNS = 160
 
 
