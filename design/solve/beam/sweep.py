@@ -69,8 +69,8 @@ class SweepFunctions:
         f = [acc[3 * nw + i] for i in range(3)]
         weights = extrapolation(P[0], *f)
         compile = compile and compiler()[0] is not None
-        self._newton_step = tr.newton_step if compile else sparse_newton_step(tr)
-        solved = self._newton(MAX_STEPS)(sum(a * wi for a, wi in zip(weights, w)), P)
+        newton = self._newton(tr.newton_step if compile else sparse_newton_step(tr), MAX_STEPS)
+        solved = newton(sum(a * wi for a, wi in zip(weights, w)), P)
         step = ca.Function("beam_continuation_step", [acc, P],
                            [ca.vertcat(solved[:nw], w[0], w[1], P[0], f[0], f[1]), solved])
         functions = [step, tr.shape_check, tr.tip_check]
@@ -83,19 +83,20 @@ class SweepFunctions:
         """acc of a run that starts from ``w`` at ``force``."""
         return np.concatenate([w, w, w, [force] * 3])
 
-    def _newton(self, steps: int) -> ca.Function:
-        """(w, P) -> [w; steps taken] after Newton steps from w, at least one,
-        until max |G| ≤ the tolerance or ``steps`` of them. Each further step
-        is a branch of a switch on the iterate, evaluated only when needed
-        (an MX ``if_else`` would make its branches functions of the run's
-        inputs and compute every earlier step again)."""
+    def _newton(self, step: ca.Function, steps: int) -> ca.Function:
+        """(w, P) -> [w; steps taken] after Newton ``step``s from w, at least
+        one, until max |G| ≤ the tolerance or ``steps`` of them. Each further
+        step is a branch of a switch on the iterate, evaluated only when
+        needed (an MX ``if_else`` would make its branches functions of the
+        run's inputs and compute every earlier step again)."""
         tr = self.tr
         w, P = ca.MX.sym("w", tr.n_w), ca.MX.sym("P", tr.n_p)
-        after = self._newton_step(w, P)
+        after = step(w, P)
         if steps > 1:
             done = ca.Function("beam_newton_done", [w, P], [ca.vertcat(w, 1)])
             more = ca.Function("beam_newton_more", [w, P],
-                               [self._newton(steps - 1)(w, P) + ca.vertcat(ca.MX(tr.n_w, 1), 1)])
+                               [self._newton(step, steps - 1)(w, P)
+                                + ca.vertcat(ca.MX(tr.n_w, 1), 1)])
             branch = ca.Function.if_else(f"beam_newton_{steps}", more, done)
             return ca.Function(f"beam_newton_from_{steps}", [w, P],
                                [branch(tr.residual_norm(after, P) > self.tolerance, after, P)])
