@@ -125,7 +125,7 @@ def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys
                               {"groups.lower.stiffness_scale": [0.5, 2.0]},
                               max_iter=20, outer_iterations=0)
 
-    def over_the_cap(population, caps, settings, rules, start, progress):
+    def over_the_cap(population, caps, settings, rules, start, progress, anchor=True):
         d0 = population.space.scale(population.space.base_values)
         return Outcome(score(population, [1.0], settings), score(population, d0, settings), caps)
 

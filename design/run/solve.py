@@ -130,8 +130,7 @@ def run(problem: DesignProblem, progress: Progress | None = None,
             entries[k]["status"] = ERROR
         if problem.multistart.starts > 1:
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
-        with profile.phase(VERIFICATION):
-            finals[k] = _verified(population, best, results[best], settings)
+        finals[k] = _verified(population, best, results[best], settings, profile)
     for k, entry in entries.items():
         entry.pop("d")
     with profile.phase(RESULT):
@@ -243,11 +242,15 @@ def _rank(result: dict) -> tuple:
             if result["status"] == VERIFIED else 0.0)
 
 
-def _verified(population: Population, key: str, result: dict, settings) -> Scored:
+def _verified(population: Population, key: str, result: dict, settings, profile: Profile
+              ) -> Scored:
     """The 4x finer simulations of a case's design: the case's own if it
     ran in this process, else simulated again (deterministic: the same)."""
     fine = _FINE.pop(key, None)
-    return fine if fine is not None else verify(population, np.array(result["d"]), settings)
+    if fine is None:
+        with profile.phase(VERIFICATION):
+            fine = verify(population, np.array(result["d"]), settings)
+    return fine
 
 
 def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[str],
