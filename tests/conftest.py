@@ -46,6 +46,7 @@ def _prefetch_jobs(session) -> list:
     from tests.test_contact_poses import REFERENCES, imposed_side_references
     from tests.test_design_solve import SETTINGS
     from tests.test_grasp import HARD, HARD_FINE, hard_run
+    from tests.test_population import TWINS, solve_twins
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
@@ -68,6 +69,9 @@ def _prefetch_jobs(session) -> list:
         jobs.append((HARD_FINE, hard_run, (4.0,), ()))
     if fixture_used("hard"):
         jobs.append((HARD, hard_run, (), ()))
+    if fixture_used("twins"):
+        # after the short grasp's baseline at the loop's tolerance, which it uses
+        jobs.append((TWINS, solve_twins, (), (simulations[0][0],)))
     if fixture_used("design_run"):
         # after the loop's and the verification's baseline runs, which it uses
         jobs.append((DESIGN_RUN, solve_short_design, (folder("design"),),

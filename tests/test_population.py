@@ -22,6 +22,7 @@ from design.solve.optimize.population import Member, Population, PopulationNLP
 from design.solve.optimize.schedule import schedule_of
 from design.solve.optimize.transcription import DesignNLP, NLPSettings
 from design.solve.optimize.trust_region import LoopSettings, simulate
+from tests import prefetch
 from tests.design_cases import sharing_simulations, stiffness_space
 
 #: test_design_solve's settings, so that the session shares the simulation
@@ -29,8 +30,13 @@ SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
 NLP = NLPSettings(time_step=0.01, max_iter=60)
 
 
-@pytest.fixture(scope="module")
-def single():
+#: the prefetch worker's key for :func:`solve_twins` (tests/prefetch.py)
+TWINS = "tests/test_population.py: the single bird's and the twins' NLPs"
+
+
+def solve_twins() -> dict:
+    """The single bird's NLP and the NLP of two copies of it, solved, with
+    the twins' size and the cap rows after a rebound to [15, 16] N."""
     space = stiffness_space("lower", "upper")
     d0 = space.scale(space.base_values)
     with sharing_simulations():
@@ -39,27 +45,35 @@ def single():
     # tighter caps or wider boxes it stops at its iteration limit, and two
     # unconverged solves need not agree
     box = (np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1))
-    result = DesignNLP(space, schedule_of(run, 0.01), run, 18.5, NLP, box=box).solve()
-    return space, run, box, result
-
-
-def test_two_copies_of_a_bird_give_the_single_birds_design(single):
-    space, run, box, alone = single
-    assert alone.success, alone.status
-    population = Population((Member("twin-a", space), Member("twin-b", space)))
     schedule = schedule_of(run, 0.01)
+    alone = DesignNLP(space, schedule, run, 18.5, NLP, box=box).solve()
+    population = Population((Member("twin-a", space), Member("twin-b", space)))
     nlp = PopulationNLP(population, [schedule, schedule], [run, run], [18.5, 18.5], NLP,
                         box=box)
     both = nlp.solve()
+    size = nlp.size
+    caps = nlp.rebound([15.0, 16.0], box).ubg[nlp._cap_rows]
+    return {"alone": alone, "both": both, "size": size, "caps": caps,
+            "per_bird": int(np.sum(nlp.nlps[0]._cap_rows))}
+
+
+@pytest.fixture(scope="module")
+def twins():
+    return prefetch.result(TWINS, solve_twins)
+
+
+def test_two_copies_of_a_bird_give_the_single_birds_design(twins):
+    alone, both = twins["alone"], twins["both"]
+    assert alone.success, alone.status
     assert both.success, both.status
     assert np.max(np.abs(both.d - alone.d)) < 1e-4
     assert abs(both.hold_time - alone.hold_time) < 1e-4
     assert np.allclose(both.peaks, alone.peak_force, rtol=1e-3)
     # one shared design, each bird's unknowns, the epigraph variable
-    assert nlp.size["members"] == 2 and nlp.size["variables"] == 2 * alone.x.size - 2 + 1
+    size = twins["size"]
+    assert size["members"] == 2 and size["variables"] == 2 * alone.x.size - 2 + 1
     # rebound gives each bird its own cap rows
-    caps = nlp.rebound([15.0, 16.0], box).ubg[nlp._cap_rows]
-    per_bird = int(np.sum(nlp.nlps[0]._cap_rows))
+    caps, per_bird = twins["caps"], twins["per_bird"]
     assert np.all(caps[:per_bird] == 15.0) and np.all(caps[per_bird:] == 16.0)
 
 
