@@ -42,7 +42,8 @@ def _prefetch_jobs(session) -> list:
     """(key, function, arguments, needs) of what the selected tests will ask
     for, roughly in the order they will (the tests take over what the worker
     has not reached); what none of them asks for is left out."""
-    from tests.design_cases import prefetch_jobs, prefetched_simulation
+    from tests.design_cases import (COMPILE, compile_finger_loads, prefetch_jobs,
+                                    prefetched_simulation)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
     from tests.test_design_solve import SETTINGS
     from tests.test_grasp import HARD, HARD_FINE, hard_run
@@ -59,6 +60,10 @@ def _prefetch_jobs(session) -> list:
 
     folder = session.config._tmp_path_factory.mktemp
     jobs = []
+    if asked(["tests/test_compiled_nlp.py", "tests/test_design_solve.py",
+              "tests/test_population.py", "tests/test_run_status.py"]):
+        # first: what it compiles, the tests load from the cache instead
+        jobs.append((COMPILE, compile_finger_loads, (), ()))
     if asked(["tests/test_contact_poses.py::test_imposed_side_matches"]):
         jobs.append((REFERENCES, imposed_side_references, (), ()))
     simulations = prefetch_jobs(SETTINGS)

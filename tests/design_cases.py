@@ -112,6 +112,23 @@ def _simulate(setup, integrator, contact_nodes, reach_filter, progress=None):
     return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress)
 
 
+#: the prefetch worker's first job: see :func:`compile_finger_loads`
+COMPILE = "tests/design_cases.py: the design NLP's compiled finger functions"
+
+
+def compile_finger_loads() -> int:
+    """Build the short grasp's finger functions for the design NLP (6
+    intervals, degree 4, both contact modes), which compiles them into the
+    cache (design/solve/compiled.py) if they are not there: about 7 s of gcc
+    on an empty cache that the optimiser tests would otherwise wait for.
+    Returns how many fingers were built."""
+    from design.solve.optimize.finger_load import FingerLoad
+    setup = short_setup()
+    for gf in setup.grasper.fingers:
+        FingerLoad(gf, setup.grasper, setup.bird, setup.finger_friction, 6, 4)
+    return len(setup.grasper.fingers)
+
+
 def prefetched_simulation(setup, integrator, contact_nodes, reach_filter):
     """The prefetch worker's job: the run, also kept in the worker's own
     cache, where its later jobs (the short design solve) find it."""
