@@ -117,6 +117,26 @@ def run(problem: DesignProblem, progress: Progress | None = None,
         results = run_study(cases, task, options=options, label=problem.name,
                             progress=None if chains == 1 else StudyProgress(quiet=progress is None),
                             problem_digest=problem_digest(problem))
+    for key in results:
+        if key in _PROFILES:
+            profile.merge(_PROFILES.pop(key))
+    try:
+        output = _assemble(problem, space, population, cases, results, baseline, caps,
+                           profile, t0)
+    finally:
+        for key in results:             # none left for a later run's case of this key
+            _FINE.pop(key, None)
+    output.result["profile"] = profile.summary()
+    return output
+
+
+def _assemble(problem: DesignProblem, space: DesignSpace, population: Population,
+              cases: list[Case], results: dict, baseline: Scored, caps: list[np.ndarray],
+              profile: Profile, t0: float) -> RunOutput:
+    """The run's output from its cases' results: per cap the best verified
+    case, a multistart's optima, a population's comparison. A failed case
+    fails the run (:class:`StudyFailed`)."""
+    settings = problem.settings
     failed = {k: r for k, r in results.items() if r["status"] in CASE_FAILED}
     if failed:
         raise StudyFailed("; ".join(f"case {k!r}: {r['status']}: {r.get('message', '')}"
@@ -131,8 +151,7 @@ def run(problem: DesignProblem, progress: Progress | None = None,
         if problem.multistart.starts > 1:
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
         finals[k] = _verified(population, best, results[best], settings, profile)
-    for k, entry in entries.items():
-        entry.pop("d")
+        entries[k].pop("d")
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
                          baseline, t0)
@@ -142,10 +161,6 @@ def run(problem: DesignProblem, progress: Progress | None = None,
         output.tables["population.csv"] = output.result["population"]["birds"]
     if problem.multistart.starts > 1:
         output.tables["starts.csv"] = output.result["multistart"]["starts"]
-    for key in results:
-        if key in _PROFILES:
-            profile.merge(_PROFILES.pop(key))
-    output.result["profile"] = profile.summary()
     return output
 
 

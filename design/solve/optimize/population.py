@@ -79,7 +79,6 @@ class PopulationNLP(DesignNLP):
         self.nlps = [DesignNLP(m.space, schedule, run, cap, settings, rules, box, progress)
                      for m, schedule, run, cap in zip(population.members, schedules, runs, caps)]
         first = self.nlps[0]
-        self.space, self.schedule, self.setup = first.space, first.schedule, first.setup
         n = self.n_design = first.n_design
         self.n_phases = sum(nlp.n_phases for nlp in self.nlps)
         d, s = ca.MX.sym("d", n), ca.MX.sym("s")
@@ -121,7 +120,6 @@ class PopulationNLP(DesignNLP):
         self.functions = ca.Function("population", [self.x], [self.f, self.g, self.force])
         self.compiled = (all(nlp.compiled[0] for nlp in self.nlps),
                          sorted({r for nlp in self.nlps for r in nlp.compiled[1]}))
-        self.objective = "hold"
         self._size, self._solver = None, None
 
     @property
