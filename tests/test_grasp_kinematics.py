@@ -121,3 +121,25 @@ def test_a_point_carried_by_the_drum_follows_its_finger_frames(tilt):
         b, R = drum.frame(mount, t)
         np.testing.assert_allclose(base[k], b, atol=1e-12)
         np.testing.assert_allclose(axis[k], R[:, 0], atol=1e-12)
+
+
+def test_the_straight_fingers_least_level_is_the_sampled_minimum():
+    """The grasp's reach test (straight_level, a parabola's closed-form
+    minimum) against the level function sampled densely along the finger:
+    equal to the sampled minimum within the sampling error (the parabola's
+    curvature times half a sample step squared), never above it."""
+    from design.solve.grasp.fingers import straight_level
+    rng = np.random.default_rng(7)
+    for _ in range(200):
+        body = Ellipsoid(*rng.uniform(0.03, 0.15, 3), tuple(rng.uniform(-0.1, 0.1, 3)),
+                         rng.uniform(-1.0, 1.0))
+        mount = FingerMount(*rng.uniform(-3, 3, 1), *rng.uniform(0.0, 0.1, 1),
+                            *rng.uniform(0.05, 0.12, 1), *rng.uniform(-3, 3, 2))
+        base, R = DRUM.frame(mount, rng.uniform(0, 1))
+        length = rng.uniform(0.05, 0.2)
+        x = np.linspace(0.0, length, 20001)
+        sampled = body.level(base[:, None] + np.outer(R[:, 0], x))
+        curvature = float(R[:, 0] @ body.rotation @ body.matrix @ body.rotation.T @ R[:, 0])
+        exact = straight_level(body, base, R[:, 0], length)
+        assert exact <= sampled.min() + 1e-12
+        assert exact >= sampled.min() - curvature * (x[1] / 2) ** 2 - 1e-12

@@ -81,3 +81,11 @@ def is_symbolic(*values) -> bool:
 def ops(*values):
     """The operation set for these values: CasADi if any is symbolic."""
     return SYMBOLIC if is_symbolic(*values) else NUMERIC
+
+
+def read_only(value):
+    """A numpy array made read-only (cached values that callers share);
+    anything else as it is."""
+    if isinstance(value, np.ndarray):
+        value.setflags(write=False)
+    return value

@@ -14,9 +14,12 @@ thesis's conic b1 x² + b2 y² + 2 b3 x y + 2 b4 x + 2 b5 y + b6 (eq. 3.6).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import casadi as ca
 import numpy as np
+
+from design.physics.backend import read_only
 
 
 def rotation(angle: float) -> np.ndarray:
@@ -51,10 +54,10 @@ class Ellipse:
     def shifted(self, dx: float, dy: float) -> "Ellipse":
         return Ellipse(self.a, self.b, (self.center[0] + dx, self.center[1] + dy), self.theta)
 
-    @property
+    @cached_property
     def matrix(self) -> np.ndarray:
         R = rotation(self.theta)
-        return R @ np.diag([1 / self.a ** 2, 1 / self.b ** 2]) @ R.T
+        return read_only(R @ np.diag([1 / self.a ** 2, 1 / self.b ** 2]) @ R.T)
 
     def level(self, x, y) -> np.ndarray:
         """f(x, y): < 0 inside, 0 on the ellipse, > 0 outside (dimensionless)."""

@@ -34,10 +34,11 @@ bird's side its fingers move downstream with the conveyor (§1.2, §4.3.3).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
-from design.physics.backend import ops
+from design.physics.backend import ops, read_only
 from design.physics.ellipse import Ellipse
 
 MIRROR = np.diag([1.0, -1.0, 1.0])
@@ -160,15 +161,15 @@ class Ellipsoid:
     center: tuple[float, float, float]
     pitch: float = 0.0
 
-    @property
+    @cached_property
     def rotation(self) -> np.ndarray:
         """Body to world. Pitch convention X = x cos θ + z sin θ (MODEL.md §5):
         a positive θ turns the body's nose (+x) downwards."""
-        return rot_y(self.pitch)
+        return read_only(rot_y(self.pitch))
 
-    @property
+    @cached_property
     def matrix(self) -> np.ndarray:
-        return np.diag([1 / self.eta ** 2, 1 / self.lam ** 2, 1 / self.gamma ** 2])
+        return read_only(np.diag([1 / self.eta ** 2, 1 / self.lam ** 2, 1 / self.gamma ** 2]))
 
     def level(self, points: np.ndarray) -> np.ndarray:
         """< 0 inside, 0 on the surface; points shape (3, ...)."""

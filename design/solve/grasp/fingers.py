@@ -50,6 +50,10 @@ REVERSAL_SPEED = 0.02
 #: speed (m/s): F_t = -µ N v / sqrt(|v|² + ε²); the drum sweeps the fingers
 #: past the bird at 0.1-0.5 m/s, so friction is within 1% of µ N above 0.14 m/s
 FRICTION_SPEED = 0.02
+#: the straight finger's least level function (dimensionless) above which it
+#: certainly misses the bird; nearer the surface the planar contact decides
+#: from its own section, whose level differs from the ellipsoid's by rounding
+MISSES = 1e-9
 
 
 @dataclass
@@ -58,7 +62,8 @@ class FingerState:
 
     ``normal_out_of_plane`` and ``sweep_out_of_plane`` (0-1): the shares of
     the bird's surface normal and of the finger's sliding over the surface
-    along the finger's stiff axis (see :meth:`FingerForces._shares`).
+    along the finger's stiff axis (see :meth:`FingerForces._shares`); nan in
+    an integrator's trial evaluations, which only need the loads.
     """
 
     force: np.ndarray = field(default_factory=lambda: np.zeros(3))   # on the bird, N
@@ -159,7 +164,10 @@ class PlanarFinger:
 
     def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
         """(force on the bird (3,) world, contact point (3,) world, solution,
-        state to continue from); force None when the plane misses the bird."""
+        state to continue from); force None when the straight finger misses
+        the bird (the spatial model's test; the section is cut only after it)."""
+        if straight_level(body, base, R[:, 0], self.solver.finger.length) > MISSES:
+            return None, None, None, None
         cut = body.cut(base, R)
         if cut is None:
             return None, None, None, None
@@ -230,6 +238,19 @@ class SpatialFinger:
 FINGER_MODELS = {"planar": PlanarFinger, "spatial": SpatialFinger}
 
 
+def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length: float) -> float:
+    """min over the straight finger (base + x axis, 0 ≤ x ≤ length) of the
+    bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
+    1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird."""
+    Rb = body.rotation
+    scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
+    p = scale * (Rb.T @ (base - np.asarray(body.center)))
+    e = scale * (Rb.T @ axis)
+    x = min(max(-float(p @ e) / float(e @ e), 0.0), length)
+    q = p + x * e
+    return float(q @ q) - 1.0
+
+
 def body_quadric(body: Ellipsoid, base: np.ndarray, R: np.ndarray) -> Quadric:
     """The bird's ellipsoid in a finger frame (base, R) as a quadric."""
     Rb = R.T @ body.rotation
@@ -260,6 +281,22 @@ class FingerForces:
         self.solves = 0            # contact problems solved
         self.skipped = 0           # finger evaluations the reach windows saved
         self._memo: dict = {}      # trial evaluations since the last commit
+        self._frames: dict = {}    # (finger, t) -> its frame, for the latest times
+
+    def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Finger i's (base, R) at time t. An evaluation asks for the same
+        frames several times (contact, rates at t + RATE_STEP, shares); the
+        arrays are shared, hence read-only."""
+        key = (i, t)
+        out = self._frames.get(key)
+        if out is None:
+            if len(self._frames) > 64 * len(self.models):
+                self._frames.clear()
+            out = self.drum.frame(self.grasper.fingers[i].mount, t)
+            for a in out:
+                a.setflags(write=False)
+            self._frames[key] = out
+        return out
 
     def active(self, i: int, t: float) -> bool:
         if self.windows is None:
@@ -290,7 +327,7 @@ class FingerForces:
         for i, gf in enumerate(self.grasper.fingers):
             force = None
             if self.active(i, t):
-                base, R = self.drum.frame(gf.mount, t)
+                base, R = self.frame(i, t)
                 # continue from the latest solution, trial or committed: the nearest
                 # in time (trials keep the committed friction); or, for a model whose
                 # friction is solved with the contact (spatial), always from the
@@ -321,8 +358,8 @@ class FingerForces:
             loads.qx += 2 * force[0]
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
-            states.append(FingerState(force, p_w, body.rotation.T @ r, sol,
-                                      *self._shares(i, t, y, body, p_w)))
+            shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
+            states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares))
         return loads, states
 
     def _shares(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, p_w: np.ndarray
@@ -331,13 +368,12 @@ class FingerForces:
         bird's surface normal along the stiff axis z_f, |n·z_f|, and of the
         finger's sweep over the surface, |v·z_f| / |v| (v the rigid finger's
         velocity relative to the bird's surface at the contact)."""
-        gf = self.grasper.fingers[i]
-        base, R = self.drum.frame(gf.mount, t)
+        base, R = self.frame(i, t)
         p_b = body.rotation.T @ (p_w - np.asarray(body.center))
         n = body.rotation @ (body.matrix @ p_b)
         n /= np.linalg.norm(n)
         dt = RATE_STEP
-        base2, R2 = self.drum.frame(gf.mount, t + dt)
+        base2, R2 = self.frame(i, t + dt)
         frame_v = (base2 + R2 @ (R.T @ (p_w - base)) - p_w) / dt
         y2 = y.copy()
         y2[:3] += dt * y[3:]
@@ -352,12 +388,11 @@ class FingerForces:
         """Rates of the bird's section (planar: the cut ellipse) or quadric
         (spatial) in finger i's frame, and the bird's surface velocity
         relative to that frame, by a forward difference over RATE_STEP."""
-        gf = self.grasper.fingers[i]
         dt = RATE_STEP
         y2 = y.copy()
         y2[:3] += dt * y[3:]
-        base, R = self.drum.frame(gf.mount, t)
-        base2, R2 = self.drum.frame(gf.mount, t + dt)
+        base, R = self.frame(i, t)
+        base2, R2 = self.frame(i, t + dt)
         body, body2 = self.ellipsoid(y), self.ellipsoid(y2)
         planar = isinstance(shape, Ellipse)
 
