@@ -3,6 +3,8 @@ thesis_table_5_1.yaml, docs/MODEL.md "Finger layout"): each test states one of
 the thesis's geometric facts and checks the straight (undeflected) fingers
 against it. No dynamics: these pin the convention, not the model."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -107,6 +109,64 @@ def test_upper_fingers_clear_the_resting_mean_bird_but_cut_the_football():
         assert np.min(np.hypot(pts[1], pts[2] - 0.066)) == pytest.approx(0.0542, abs=5e-4)
 
 
+def brute_clearance(gf, axes, mount=None) -> float:
+    """Distance (m) from the straight finger facing the resting object to the
+    whole ellipsoid's surface, sampled densely in 3-D (no symmetry used)."""
+    m = mount or gf.mount
+    base, R = DRUM.frame(m, (m.angle - np.pi / 2) / OMEGA)
+    pts = base[:, None] + np.outer(R[:, 0], np.linspace(0, gf.finger.length, 121))
+    # the surface within 20 mm of the plane X = X_base, where the nearest points lie
+    x, phi = np.meshgrid(np.linspace(-0.02, 0.02, 41), np.linspace(-np.pi, np.pi, 721))
+    r = np.sqrt(1 - (x / axes[0]) ** 2)
+    surf = np.stack([base[0] + x, axes[1] * r * np.cos(phi),
+                     axes[2] * (1 + r * np.sin(phi))]).reshape(3, -1)
+    return float(np.min(np.linalg.norm(pts[:, :, None] - surf[:, None, :], axis=0)))
+
+
+def test_transverse_clearance_against_the_sampled_ellipsoid():
+    """design/physics/clearance.py measures in the transverse section (the
+    thesis's Figure 5-3); the whole ellipsoid sampled in 3-D gives the same
+    distance for Table 5-1's upper fingers over the mean bird (5.2 mm) and
+    for the football's tilted ones, within the sampling (points 1 mm
+    apart along the finger, 1 mm apart along X and 0.5° around: its error is under 0.05 mm near a
+    smooth minimum)."""
+    from design.physics.clearance import clearance
+    for name in ("1a", "2a"):
+        gf = finger(name)
+        c = clearance(DRUM, gf.mount, gf.finger.length, 0.066, 0.057)
+        assert c == pytest.approx(0.0052, abs=5e-5)
+        assert brute_clearance(gf, (0.097, 0.066, 0.057)) == pytest.approx(c, abs=5e-5)
+        tilted = replace(gf.mount, phi_y=np.radians(-26.63))
+        c = clearance(DRUM, tilted, gf.finger.length, 0.066, 0.066)
+        assert brute_clearance(gf, (0.122, 0.066, 0.066), tilted) == pytest.approx(c, abs=5e-5)
+        # entering the ball: minus the depth of the finger's deepest point
+        assert clearance(DRUM, gf.mount, gf.finger.length, 0.066, 0.066) == \
+            pytest.approx(0.0542 - 0.066, abs=5e-4)
+
+
+def test_the_footballs_upper_fingers_clear_it_as_table_5_1s_clear_the_mean_bird():
+    """§5.1 tunes fingers 1 and 2's tilt to the bird's size: the football's
+    tilt (upper_tilt) leaves it the mean bird's 5.2 mm clearance, and the
+    football scene carries that tilt (to its printed 0.01°)."""
+    from design.io.scene import load_scene
+    from design.physics.clearance import clearance
+    from design.reproduce.grasp import football_setup, load_model, upper_tilt
+    from design.io.grasp_scene import read_bird
+
+    mean, ball = (load_model(read_bird, "birds", f) for f in ("mean_1_80kg.yaml", "football.yaml"))
+    tilts = upper_tilt(GRASPER, ball, mean)
+    scene = load_scene("problems/grasp_football.yaml")
+    for name, tilt in tilts.items():
+        gf = finger(name + "a")
+        assert np.degrees(tilt) == pytest.approx(-26.63, abs=0.01)
+        assert clearance(DRUM, replace(gf.mount, phi_y=tilt), gf.finger.length, ball.lam,
+                         ball.gamma) == pytest.approx(clearance(DRUM, gf.mount, gf.finger.length,
+                                                                mean.lam, mean.gamma), abs=1e-9)
+        for s in (scene.grasper, football_setup().grasper):
+            mounted = next(f for f in s.fingers if f.name == name + "a").mount
+            assert np.degrees(mounted.phi_y) == pytest.approx(np.degrees(tilt), abs=0.01)
+
+
 def reached_fingers(x0: float, duration: float) -> set[str]:
     """Designed fingers whose straight copies enter the resting mean bird
     (Table 5-3) carried from X0 at 0.457 m/s, sampled every millisecond."""
@@ -159,7 +219,8 @@ def test_upstream_starts_meet_the_fingers_as_the_mean_bird_does():
     from design.reproduce.grasp import (MEAN_START, belt_arrival, football_setup,
                                         mean_bird_setup, set_period)
 
-    football, mean = football_setup(), mean_bird_setup("hard")
+    # Table 5-1's upper-finger tilt: the football's own tilt turns fingers 1, 2 only
+    football, mean = football_setup(tilted=False), mean_bird_setup("hard")
     t1 = belt_arrival(football.conveyor, football.start_x, MEAN_START)
     drum_f, drum_m = (s.grasper.drum(s.drum_speed) for s in (football, mean))
     for gf_f, gf_m in zip(football.grasper.fingers, mean.grasper.fingers):

@@ -44,7 +44,8 @@ def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
          lambda progress: contact_rows.sections(contact_rows.compute())),
     ]
     if not quick:
-        chapters.append(("chapter V: grasp figures (19 runs, most with the spatial finger model)",
+        chapters.append((f"chapter V: grasp figures ({len(grasp_rows.setups())} runs, most with "
+                         "the spatial finger model)",
                          lambda progress: grasp_rows.sections(grasp_rows.compute(progress))))
     return chapters
 

@@ -12,6 +12,7 @@ from design.io.fingers import read_finger
 from design.io.grasp_scene import read_bird, read_conveyor, read_grasper
 from design.io.reader import Reader
 from design.physics.bird import Conveyor, Legs, belt_motion
+from design.physics.clearance import clearance, matching_tilt
 from design.solve.grasp.simulation import GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
@@ -122,16 +123,42 @@ def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL,
     return s
 
 
+def upper_tilt(grasper, bird, reference, speed: float = OMEGA) -> dict[str, float]:
+    """φy (rad) of fingers 1 and 2 at which they clear ``bird`` at rest by
+    what Table 5-1's tilt leaves ``reference`` (the mean bird): 5.2 mm in
+    the transverse section (design/physics/clearance.py).
+
+    §5.1: fingers 1 and 2 restrain the bird from above, and their tilt is
+    tuned to the birds' size (Figure 5-3 draws it in that section). Table
+    5-1's -15° is the mean bird's; the football (66 mm high, not 57) would be
+    cut 11.8 mm deep by it. The thesis prints no football layout, and its
+    figures depart from Table 5-1 elsewhere (finger 3 at φx = 60° in Figures
+    5-16 to 5-18, finger 2 drawn at φy = -10° in Figure 5-4)."""
+    drum = grasper.drum(speed)
+    out = {}
+    for name in ("1", "2"):
+        gf = next(f for f in grasper.fingers if f.design_name == name)
+        target = clearance(drum, gf.mount, gf.finger.length, reference.lam, reference.gamma)
+        out[name] = matching_tilt(drum, gf.mount, gf.finger.length, target, bird.lam,
+                                  bird.gamma)
+    return out
+
+
 def football_setup(start: float = FOOTBALL_START, friction: float = 1.16,
                    phi_x3: float = 60.0, model: str = VALIDATION_MODEL,
-                   phased: bool = True) -> GraspSetup:
+                   phased: bool = True, tilted: bool = True) -> GraspSetup:
     """The Table 5-4 football on the Figure 5-10 belt from ``start`` (m): finger
-    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs; the drums
-    in :func:`designed_phase` unless ``phased`` is false (Table 5-1's angles
-    at t = 0)."""
+    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs; fingers 1
+    and 2 tilted to the football (:func:`upper_tilt`) unless ``tilted`` is
+    false (Table 5-1's -15°); the drums in :func:`designed_phase` unless
+    ``phased`` is false (Table 5-1's angles at t = 0)."""
     s = thesis_setup(0.0, FOOTBALL_DURATION, "hard", "football.yaml", start,
                      "decelerate_figure_5_10.yaml", friction, Legs(0.0, 0.0), model)
     s = with_phi_x(replace(s, conveyor_friction=1.16), "3", phi_x3)
+    if tilted:
+        mean = load_model(read_bird, "birds", "mean_1_80kg.yaml")
+        tilts = upper_tilt(s.grasper, s.bird, mean, s.drum_speed)
+        s = replace(s, grasper=s.grasper.remounted({n: {"phi_y": a} for n, a in tilts.items()}))
     return designed_phase(s) if phased else s
 
 

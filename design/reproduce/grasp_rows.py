@@ -15,6 +15,8 @@ from dataclasses import replace
 
 import numpy as np
 
+from design.physics.bird import G
+from design.physics.kinematics import rot_y
 from design.reproduce.figures import finger_force_x_figure, path_figure
 from design.reproduce.grasp import (SIZES_START, football_setup, mean_bird_setup, simulate_all,
                                     sizes_setup)
@@ -31,6 +33,7 @@ PLACED = ", placed at X0 = -0.075 m at t = 0"
 SOFT_PLACED, CONSTANT_PLACED = SOFT + PLACED, CONSTANT + PLACED
 FOOTBALL = "football (Table 5-4), µ = 1.16"
 FOOTBALL_LITERAL = f"{FOOTBALL}, Table 5-1's angles at t = 0"
+FOOTBALL_PRINTED = f"{FOOTBALL}, fingers 1 and 2 at Table 5-1's tilt"
 BIRDS = ("small_1_20kg", "mean_1_66kg", "mean_1_80kg", "large_2_05kg", "large_2_30kg")
 #: Figure 5-7: forces 'concentrate densely' from -1.5 to +1.5 in of the drums (m)
 DENSE = 0.0381
@@ -43,11 +46,9 @@ READING_REL = 0.3
 HEIGHT_TOL = 0.005
 #: 'passes the grasper': ends past the drum axis, and never backs off more than this (m)
 BACK_OFF = 0.01
-#: wall time allowed per run (s): the football in the designed phase takes
-#: about 100 s of CPU time (140-430 s of wall on a loaded 2-core machine);
-#: read literally it reaches a stiff stretch
-#: at t = 1.32 s (finger 1b near a singular equilibrium, eigenvalue about
-#: -1e5 /s) where it crawls; a run stopped by it is reported as not finished
+#: wall time allowed per run (s): each run takes 2-30 s of CPU time (the
+#: football runs the longest), so this only stops a run that has gone wrong;
+#: one it stops is reported as not finished
 RUN_BUDGET = 360.0
 
 
@@ -64,7 +65,8 @@ def setups() -> dict:
            SOFT_PLACED: mean_bird_setup("soft", arriving=False),
            CONSTANT_PLACED: mean_bird_setup("constant", arriving=False),
            FOOTBALL: football_setup(),
-           FOOTBALL_LITERAL: football_setup(phased=False)}
+           FOOTBALL_LITERAL: football_setup(phased=False),
+           FOOTBALL_PRINTED: football_setup(tilted=False)}
     out.update({football_far(f"finger µ = {mu:g}"): football_setup(SIZES_START, mu)
                 for mu in (0.0, 0.4, 1.16)})
     out.update({football_far(f"finger 3 φx = {deg:g}°"): football_setup(SIZES_START, 1.16, deg)
@@ -145,6 +147,33 @@ def impulse_share(run: GraspRun, where) -> float:
     return float(np.trapezoid(force * inside, t) / np.trapezoid(force, t))
 
 
+def net_lift(run: GraspRun) -> float:
+    """Largest upward force of all fingers (both drums) on the bird less its
+    weight, N: its largest upward acceleration times its mass while the belt
+    does not touch it."""
+    recs = run.trajectory.records
+    up = max(2 * sum(f.force[2] for f in r.fingers) for r in recs)
+    return float(up - run.setup.bird.mass * G)
+
+
+def peak_split(run: GraspRun) -> str:
+    """The peak finger force in parts: world components (right drum; the
+    left drum's mirror has Y reversed), and the push along the bird's
+    surface normal against the friction along its surface."""
+    recs = run.trajectory.records
+    k = next(i for i, r in enumerate(recs) if r.t == run.summary["max_finger_force_time_s"])
+    j = [gf.name for gf in run.setup.grasper.fingers].index(run.summary["max_finger_force_finger"])
+    state, b = recs[k].fingers[j], run.setup.bird
+    rotation = rot_y(recs[k].y[2])
+    normal = rotation @ (state.body_point / np.array([b.eta, b.lam, b.gamma]) ** 2)
+    push = -float(state.force @ normal / np.linalg.norm(normal))
+    friction = float(np.sqrt(max(state.force @ state.force - push ** 2, 0.0)))
+    fx, fy, fz = state.force
+    return (f"{_peak(run)} = ({fx:+.1f}, {fy:+.1f}, {fz:+.1f}) N in X, Y, Z (+Y away from "
+            f"its drum, towards the other), {push:.1f} N along the surface normal and "
+            f"{friction:.1f} N of friction along the surface")
+
+
 def _peak(run: GraspRun) -> str:
     s = run.summary
     return f"{s['max_finger_force_N']:.1f} N at finger {s['max_finger_force_finger']}"
@@ -173,7 +202,8 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
                   f"Ours: {_peak(run)}. Criterion: the same finger."),
             compare(case, f"peak finger force, {label}", "N", PEAK_MEAN, s["max_finger_force_N"],
                     READING_REL * PEAK_MEAN, "'In the order of 11N' (two sides x 11 N is about "
-                    "the bird's 17.7 N weight); tolerance 30 % for a reading."),
+                    f"the bird's 17.7 N weight); tolerance 30 % for a reading. Ours: "
+                    f"{peak_split(run)}."),
             claim(case, f"share of the finger force-time integral while |X| <= 38.1 mm, {label}",
                   "most ('concentrate densely' from -1.5 to +1.5 in)",
                   impulse_share(run, lambda r: abs(r.y[0]) <= DENSE),
@@ -270,8 +300,22 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
               f"finger {peak_family(run)}", peak_family(run) == "4",
               f"Ours: {_peak(run)}. Criterion: the same finger."),
         compare(case, "peak finger force", "N", PEAK_FOOTBALL, fb["max_finger_force_N"],
-                READING_REL * PEAK_FOOTBALL, "§5.3's estimate from the ball's inertia, 8.52 N; "
-                "tolerance 30 %.")]
+                READING_REL * PEAK_FOOTBALL, "§5.3's estimate from the ball's inertia, 8.52 N, "
+                "which it calls close to the simulation's largest finger force; tolerance 30 %. "
+                f"Ours: {peak_split(run)}."),
+        compare(case, "largest upward force of the fingers less the ball's weight", "N",
+                PEAK_FOOTBALL, net_lift(run), READING_REL * PEAK_FOOTBALL,
+                "What §5.3's 8.52 N = m A (2π/T)² measures: the ball's largest vertical "
+                "inertial force (A 0.8 in, T 0.2 s, read off the Z trace); ours from the "
+                "fingers' Z forces, both drums; tolerance 30 %.")]
+    printed_run = runs[FOOTBALL_PRINTED]
+    printed = lambda: [compare(  # noqa: E731
+        case, "maximum rise of the centre with fingers 1 and 2 at Table 5-1's tilt (-15°)", "m",
+        RISE_FOOTBALL, printed_run.summary["centre_rise_m"], READING_REL * RISE_FOOTBALL,
+        f"Table 5-1's upper fingers, set for the mean bird, enter the resting football 11.8 mm "
+        f"deep and press it onto finger 4: {_motion(printed_run)}. The football rows above tilt "
+        f"them to clear the ball as they clear the mean bird (5.2 mm), the thesis's rule of "
+        f"§5.1; it prints no football layout.")]
     literal_run = runs[FOOTBALL_LITERAL]
     literal = lambda: [claim(  # noqa: E731
         case, "finger 4 carries the ball with the drums at Table 5-1's angles at t = 0 (the "
@@ -294,6 +338,8 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
     return (unfinished(experiment, runs, [FOOTBALL], case, "the experiment (rise, pitch, "
                        "passing, peak finger and force)", "rise 18 mm, passes, finger 4 about "
                        "8.5 N")
+            + unfinished(printed, runs, [FOOTBALL_PRINTED], case, "rise with Table 5-1's "
+                         "upper-finger tilt", "around 0.018 m")
             + unfinished(literal, runs, [FOOTBALL_LITERAL], case, "finger 4 with Table 5-1's "
                          "angles at t = 0", "finger 4 supports the weight (§5.3)")
             + unfinished(start, runs, [FOOTBALL, far[1.16]], "Figure 5-16, football",
@@ -361,8 +407,9 @@ def sections(runs: dict[str, GraspRun]) -> list[Section]:
         "N/m, c = 1.5 N s/m), arriving: started one set period (1 s) upstream of X0 = -0.075 "
         "m, so that it reaches X0 as the next finger set stands at Table 5-1's angles, then "
         "0.6 s; one row per case starts it at X0 as printed, on finger 4a. Football: Table 5-4 on the Figure 5-10 "
-        "belt (2 m/s² assumed), finger 3 at φx = 60° as in Figures 5-16 to 5-18, no legs, "
-        "1.6 s. Table 5-5 birds: X0 = -0.381 m, µ = 0.4, on the Figure 5-10 belt. The "
+        "belt (2 m/s² assumed), finger 3 at φx = 60° as in Figures 5-16 to 5-18, fingers 1 "
+        "and 2 tilted to φy = -26.6° so that they clear the resting ball as Table 5-1's -15° "
+        "clears the mean bird (5.2 mm, §5.1's rule; one row keeps -15°), no legs, 1.6 s. Table 5-5 birds: X0 = -0.381 m, µ = 0.4, on the Figure 5-10 belt. The "
         "football and Table 5-5 runs start upstream, where the thesis prints no drum phase: "
         "the drums are turned so that the belt brings the bird to Table 5-3's X0 = -0.075 m "
         "as the fingers reach their Table 5-1 angles (the mean bird's timing, the grasper "

@@ -11,6 +11,10 @@
   leaning at most 17.5° out of it (sin 17.5° = 0.3: the discarded part of
   the push is then under 5% of it and the in-plane force points within
   17.5° of the true one).
+* A run that starts with the bird already held off the belt (N = 0 at
+  t = 0, a finger pressing on it) begins inside a grasp that no finger
+  swept into: its first hold window is an artefact of the start, and the
+  run says so.
 * A finger that passes below the conveyor's surface under the bird is
   reported: the thesis's birds and football sit on pallets at least as wide
   as the bird (§A, Fig 1-1), so a finger point below Z = 0 within the bird's
@@ -79,7 +83,11 @@ def contact_validity(run) -> dict:
                                 "depth_m": float(-pts[2][under].min())})
                 break
     worst = max((v["normal_out_of_plane_max"] for v in per_finger.values()), default=0.0)
+    first = recs[0]
+    held = [(gf.name, f.magnitude) for gf, f in zip(setup.grasper.fingers, first.fingers)
+            if f.magnitude > 0] if first.mode == "air" else []
     return {"fingers": per_finger, "forces_beyond_fold": beyond,
+            "held_at_start": [{"finger": n, "force_N": f} for n, f in held],
             "fingers_through_conveyor": through,
             "normal_out_of_plane_max": worst,
             "planar_model_valid": setup.finger_model != "planar" or worst <= PLANAR_LIMIT}
@@ -104,4 +112,9 @@ def validity_problems(validity: dict) -> list[str]:
             for b in validity["forces_beyond_fold"]]
     out += [f"finger {b['finger']} passed {1e3 * b['depth_m']:.1f} mm through the belt under "
             f"the bird at {b['time_s']:.3f} s" for b in validity["fingers_through_conveyor"]]
+    held = validity.get("held_at_start", [])
+    if held:
+        out.append("the bird starts held off the belt by finger(s) " + ", ".join(
+            f"{h['finger']} ({h['force_N']:.1f} N)" for h in held) + " at t = 0, placed inside "
+            "their reach: the first hold window begins with the run, not with a grasp")
     return out
