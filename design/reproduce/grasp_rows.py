@@ -190,7 +190,10 @@ def mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
 def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
     case = "Figure 5-7, mean bird (Table 5-3)"
     rows = []
-    for name, label in ((SOFT, "soft lower fingers (case 2)"), (CONSTANT, "constant EI")):
+    # Figure 5-7's caption and legend compare soft (EI2) with hard (EI3) lower
+    # fingers; Figure 5-6's captions number a constant-EI case 3: all three
+    for name, label in ((SOFT, "soft lower fingers (case 2)"), (HARD, "hard lower fingers"),
+                        (CONSTANT, "constant EI")):
         run = runs[name]
         s = run.summary
         rows += [
