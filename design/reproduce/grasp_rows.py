@@ -149,8 +149,8 @@ def impulse_share(run: GraspRun, where) -> float:
 
 def net_lift(run: GraspRun) -> float:
     """Largest upward force of all fingers (both drums) on the bird less its
-    weight, N: its largest upward acceleration times its mass while the belt
-    does not touch it."""
+    weight, N: where the belt does not touch the bird, its mass times its
+    upward acceleration."""
     recs = run.trajectory.records
     up = max(2 * sum(f.force[2] for f in r.fingers) for r in recs)
     return float(up - run.setup.bird.mass * G)
@@ -270,16 +270,33 @@ def _motion(run: GraspRun) -> str:
             f"{np.degrees(s['max_pitch_rad']):.0f}°, peak {_peak(run)}")
 
 
-def pushed_back(runs: dict[str, GraspRun], case: str, what: str, named: dict[str, str]) -> Row:
+def x_impulse(run: GraspRun, name: str | None = None) -> float:
+    """Time integral of the fingers' X force on the bird, both drums (N s; <
+    0 pushes it back): of the designed finger ``name``, or of all."""
+    recs = run.trajectory.records
+    families = [gf.design_name for gf in run.setup.grasper.fingers]
+    fx = [2 * sum(f.force[0] for f, n in zip(r.fingers, families) if name in (None, n))
+          for r in recs]
+    return float(np.trapezoid(fx, [r.t for r in recs]))
+
+
+def pushed_back(runs: dict[str, GraspRun], case: str, what: str, named: dict[str, str],
+                finger: str | None = None) -> Row:
     """The thesis's 'pushed back at the first setting, passes at the others'
-    (Figures 5-17, 5-18) against the runs ``named`` {setting label: run name}."""
+    (Figures 5-17, 5-18) against the runs ``named`` {setting label: run name};
+    the explanation gives the fingers' X impulse in each (of ``finger`` if
+    the setting is that finger's)."""
     (first, head), *rest = named.items()
     others = " and ".join(label for label, _ in rest)
     statement = f"pushed back at {first}; passes at {others}"
+    whose = f"finger {finger}'s" if finger else "all fingers'"
+    impulses = ", ".join(f"{label} {x_impulse(runs[n], finger):+.3f} N s"
+                         for label, n in named.items())
     return claim(case, f"{what}: {statement}", statement,
                  "; ".join(f"{label}: {_motion(runs[n])}" for label, n in named.items()),
                  not passes(runs[head]) and all(passes(runs[n]) for _, n in rest),
-                 f"Criterion: {first} does not pass, {others} do.")
+                 f"Criterion: {first} does not pass, {others} do. Ours, {whose} X impulse "
+                 f"on the ball (both drums, < 0 pushes it back): {impulses}.")
 
 
 def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
@@ -337,7 +354,7 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         {f"µ = {m:g}": n for m, n in far.items()})]
     mount = lambda: [pushed_back(  # noqa: E731
         runs, "Figure 5-18, football from X0 = -0.381 m", "finger 3's φx",
-        {f"{d:g}°": n for d, n in phi.items()})]
+        {f"{d:g}°": n for d, n in phi.items()}, "3")]
     return (unfinished(experiment, runs, [FOOTBALL], case, "the experiment (rise, pitch, "
                        "passing, peak finger and force)", "rise 18 mm, passes, finger 4 about "
                        "8.5 N")
