@@ -7,11 +7,15 @@ import numpy as np
 from design.reproduce.grasp_rows import BACK_OFF, pushed_back
 
 
-def run(xs):
-    """A run whose centre X goes through ``xs`` (m)."""
-    records = [SimpleNamespace(y=np.array([x, 0.07, 0.0])) for x in xs]
+def run(xs, fx=-1.0):
+    """A run whose centre X goes through ``xs`` (m), one per 0.5 s, with one
+    finger (finger 3) pushing along X by ``fx`` (N) throughout."""
+    finger = SimpleNamespace(force=np.array([fx, 0.0, 0.0]))
+    records = [SimpleNamespace(y=np.array([x, 0.07, 0.0]), t=0.5 * k, fingers=[finger])
+               for k, x in enumerate(xs)]
+    grasper = SimpleNamespace(fingers=[SimpleNamespace(design_name="3")])
     return SimpleNamespace(trajectory=SimpleNamespace(records=records),
-                           setup=SimpleNamespace(duration=1.6),
+                           setup=SimpleNamespace(duration=1.6, grasper=grasper),
                            summary={"centre_rise_m": 0.01, "max_pitch_rad": 0.1,
                                     "max_finger_force_N": 9.0, "max_finger_force_finger": "4a"})
 
@@ -25,6 +29,8 @@ def test_pushed_back_holds_only_when_the_first_fails_and_the_others_pass():
     row = pushed_back({"back": back, "through": through, "also": through}, "Fig", "friction",
                       named)
     assert row.agrees and row.thesis == "pushed back at µ = 0; passes at µ = 0.4 and µ = 1.16"
+    # both drums' -1 N for 1 s
+    assert "µ = 0 -2.000 N s" in row.explanation
     assert not pushed_back({"back": through, "through": through, "also": through}, "Fig",
                            "friction", named).agrees
     assert not pushed_back({"back": back, "through": through, "also": back}, "Fig",
