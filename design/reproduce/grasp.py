@@ -9,7 +9,7 @@ from scipy.optimize import brentq
 
 from design.io.files import TOOLKIT_ROOT
 from design.io.fingers import read_finger
-from design.io.grasp_scene import read_bird, read_conveyor, read_grasper
+from design.io.grasp_scene import GraspSettings, read_bird, read_conveyor, read_grasper
 from design.io.reader import Reader
 from design.physics.bird import Conveyor, Legs, belt_motion
 from design.physics.clearance import clearance, matching_tilt
@@ -23,6 +23,10 @@ MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
 #: at the contacts lies up to 0.8-0.97 along the fingers' stiff axes, beyond
 #: the planar model's limit (design/solve/grasp/validity.py)
 VALIDATION_MODEL = "spatial"
+#: the spatial rod's collocation intervals: 3 change hold and peak by under
+#: 5e-6 (relative) against 10, at 0.45x the time of the default 6
+#: (benchmarks/spatial_mesh.py); the planar finger keeps the default
+SPATIAL_NODES = 3
 #: Table 5-3's 0.6 s from X0 (Figures 5-5 to 5-9: -0.075 to +0.15 m); the
 #: football's one and a half drum cycles of video (§5.3)
 MEAN_DURATION, FOOTBALL_DURATION = 0.6, 1.6
@@ -182,5 +186,6 @@ def simulate_all(setups: dict[str, GraspSetup], progress=None,
     for k, (name, setup) in enumerate(setups.items(), 1):
         if progress:
             progress(f"grasp run {k}/{len(setups)}: {name}")
-        runs[name] = simulate_grasp(setup, IntegratorSettings(max_wall_time=budget))
+        nodes = SPATIAL_NODES if setup.finger_model == "spatial" else GraspSettings().contact_nodes
+        runs[name] = simulate_grasp(setup, IntegratorSettings(max_wall_time=budget), nodes)
     return runs
