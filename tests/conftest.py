@@ -51,6 +51,8 @@ def _prefetch_jobs(session) -> list:
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
+    from tests.test_validation import (FOOTBALL, MEAN_HARD, MEAN_SOFT, football_run,
+                                       mean_bird_run)
 
     def asked(users: list[str]) -> bool:
         return any(item.nodeid.startswith(tuple(users)) for item in session.items)
@@ -87,6 +89,12 @@ def _prefetch_jobs(session) -> list:
         jobs.append((BEAM_STUDY, beam_study, (folder("tradeoff") / "out",), ()))
     if asked(["tests/test_tradeoff.py::test_grasp_window_keeps"]):
         jobs.append((GRASP_WINDOW, grasp_window_study, (), ()))
+    if fixture_used("football"):
+        jobs.append((FOOTBALL, football_run, (), ()))
+    if fixture_used("mean_soft"):
+        jobs.append((MEAN_SOFT, mean_bird_run, ("soft",), ()))
+    if fixture_used("mean_hard"):
+        jobs.append((MEAN_HARD, mean_bird_run, ("hard",), ()))
     return jobs
 
 
