@@ -24,8 +24,8 @@ from design.physics.kinematics import Drum, FingerMount
 SAMPLES = 720
 
 
-def _facing(drum: Drum, mount: FingerMount, length: float) -> tuple[np.ndarray, np.ndarray]:
-    """The straight finger's base and tip (Y, Z) when it faces the object."""
+def facing(drum: Drum, mount: FingerMount, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """The straight finger's base and tip (Y, Z; m) when it faces the object."""
     if drum.tilt != 0.0:
         raise ValueError("the transverse clearance needs an untilted drum")
     base, R = drum.frame(mount, (mount.angle - np.pi / 2) / drum.speed)
@@ -46,7 +46,7 @@ def clearance(drum: Drum, mount: FingerMount, length: float, lam: float, gamma: 
     object's transverse section (semi-axes ``lam``, ``gamma``, centre at
     height ``gamma`` under the conveyor's centre line); negative when the
     finger enters it (then minus the depth of the finger's deepest point)."""
-    a, b = _facing(drum, mount, length)
+    a, b = facing(drum, mount, length)
     centre = np.array([0.0, gamma])
     scale = np.array([lam, gamma])
     s = np.linspace(0.0, 1.0, 201)

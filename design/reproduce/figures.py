@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
+from design.physics.clearance import facing
 from design.physics.contact import ContactSolution
 from design.reproduce.contact import FEM_PASS, THESIS_PASS, pass_angle
 
@@ -122,4 +123,32 @@ def path_figure(runs: dict, title: str, height: float | None = None) -> Figure:
     ax.set_ylabel("centre Z (mm)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
+    return fig
+
+
+def transverse_figure(graspers: dict, birds: dict, families: tuple[str, ...] = ("1", "2")
+                      ) -> Figure:
+    """Figure 5-3 redrawn: the resting birds' transverse sections through the
+    drum axes and the straight fingers of ``families`` facing them, one line
+    style per grasper (dicts by label; the right drum, Y and Z in mm)."""
+    fig = Figure(figsize=(7, 4.6))
+    ax = fig.add_subplot(1, 1, 1)
+    t = np.linspace(0.0, 2 * np.pi, 361)
+    for k, (label, bird) in enumerate(birds.items()):
+        ax.plot(bird.lam * np.cos(t) * MM, bird.gamma * (1 + np.sin(t)) * MM, color=f"C{k}",
+                lw=1.8, label=f"{label} ({bird.lam * MM:.0f} x {bird.gamma * MM:.0f} mm)")
+    for style, (label, grasper) in zip(("-", "--", ":"), graspers.items()):
+        drum = grasper.drum(1.0)
+        shown = [gf for gf in grasper.fingers
+                 if gf.design_name in families and gf.name.endswith("a")]
+        for k, gf in enumerate(shown):
+            (y0, z0), (y1, z1) = facing(drum, gf.mount, gf.finger.length)
+            ax.plot([y0 * MM, y1 * MM], [z0 * MM, z1 * MM], "k" + style, lw=1.4,
+                    label=f"fingers {', '.join(families)}, {label}" if k == 0 else None)
+    ax.axhline(0.0, color="0.5", lw=0.8)
+    ax.set_xlabel("Y (mm, the right drum's side)")
+    ax.set_ylabel("Z above the belt (mm)")
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
     return fig

@@ -17,7 +17,7 @@ import numpy as np
 
 from design.physics.bird import G
 from design.physics.kinematics import rot_y
-from design.reproduce.figures import finger_force_x_figure, path_figure
+from design.reproduce.figures import finger_force_x_figure, path_figure, transverse_figure
 from design.reproduce.grasp import (SIZES_START, football_setup, mean_bird_setup, simulate_all,
                                     sizes_setup)
 from design.reproduce.rows import CaseFailed, Row, Section, claim, compare
@@ -447,4 +447,18 @@ def sections(runs: dict[str, GraspRun]) -> list[Section]:
          (path_figure(sizes, "Table 5-5 birds from X0 = -0.381 m", HEIGHT_MEAN),
           "grasp_bird_sizes", "Figure 5-19(a) redrawn: centre height against X."),
          (path_figure(fb, "Football from X0 = -0.381 m"), "grasp_football_friction",
-          "Figure 5-17 redrawn: the football's centre path for finger µ = 0, 0.4, 1.16.")])]
+          "Figure 5-17 redrawn: the football's centre path for finger µ = 0, 0.4, 1.16."),
+         (transverse_figure(
+             {f"φy {np.degrees(_phi_y(runs[k], '1')):.2f}°": runs[k].setup.grasper
+              for k in (FOOTBALL_PRINTED, FOOTBALL)},
+             {"mean bird": runs[SOFT].setup.bird, "football": runs[FOOTBALL].setup.bird}),
+          "grasp_upper_tilt", "Figure 5-3 redrawn: the resting mean bird's and football's "
+          "sections through the drum axes and the straight fingers 1 and 2 facing them, at "
+          "Table 5-1's tilt (5.2 mm above the mean bird, 11.8 mm into the football) and at "
+          "the football's (5.2 mm above it).")])]
+
+
+def _phi_y(run: GraspRun, family: str) -> float:
+    """φy (rad) of the run's finger ``family`` (set a)."""
+    return next(gf.mount.phi_y for gf in run.setup.grasper.fingers
+                if gf.design_name == family and gf.name.endswith("a"))
