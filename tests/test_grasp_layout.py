@@ -240,3 +240,13 @@ def test_upstream_starts_meet_the_fingers_as_the_mean_bird_does():
         base, R = drum_m.frame(f.mount, period)
         assert any(np.allclose(base, b, atol=1e-12) and np.allclose(R, r, atol=1e-12)
                    for b, r in frames)
+
+
+def test_a_clearance_no_tilt_can_give_is_refused_with_the_reachable_range():
+    """matching_tilt searches φy in a bracket; a target outside what the
+    bracket's tilts give is an error that says the range, not a root."""
+    from design.physics.clearance import matching_tilt
+    gf = finger("1a")
+    with pytest.raises(ValueError, match=r"no tilt in \[-20, 0\] deg clears the object by 50 mm"):
+        matching_tilt(DRUM, gf.mount, gf.finger.length, 0.05, 0.066, 0.066,
+                      (np.radians(-20.0), 0.0))

@@ -76,4 +76,9 @@ def matching_tilt(drum: Drum, mount: FingerMount, length: float, target: float, 
     def excess(phi_y: float) -> float:
         return clearance(drum, replace(mount, phi_y=phi_y), length, lam, gamma) - target
 
+    ends = [excess(a) for a in bracket]
+    if ends[0] * ends[1] > 0:
+        raise ValueError(f"no tilt in [{np.degrees(bracket[0]):g}, {np.degrees(bracket[1]):g}] "
+                         f"deg clears the object by {1e3 * target:g} mm: the clearance spans "
+                         f"{1e3 * (ends[0] + target):.1f} to {1e3 * (ends[1] + target):.1f} mm")
     return float(brentq(excess, *bracket, xtol=1e-9))
