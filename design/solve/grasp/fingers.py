@@ -22,7 +22,8 @@ and Z forces and moment.
 
 Model only what can touch: :func:`reach_windows` finds, from the undeformed
 finger loci (eq. 5.1), the time windows in which a finger can reach the bird
-at all; outside them no contact problem is built or solved.
+at all; outside them no contact problem is built or solved, and inside them
+none either while the straight finger misses the bird (:func:`straight_level`).
 """
 
 from __future__ import annotations
@@ -51,8 +52,9 @@ REVERSAL_SPEED = 0.02
 #: past the bird at 0.1-0.5 m/s, so friction is within 1% of µ N above 0.14 m/s
 FRICTION_SPEED = 0.02
 #: the straight finger's least level function (dimensionless) above which it
-#: certainly misses the bird; nearer the surface the planar contact decides
-#: from its own section, whose level differs from the ellipsoid's by rounding
+#: certainly misses the bird and no contact is solved; nearer the surface each
+#: finger model decides by its own test (the planar one from its section,
+#: whose level differs from the ellipsoid's by rounding)
 MISSES = 1e-9
 
 
@@ -164,10 +166,7 @@ class PlanarFinger:
 
     def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
         """(force on the bird (3,) world, contact point (3,) world, solution,
-        state to continue from); force None when the straight finger misses
-        the bird (the spatial model's test; the section is cut only after it)."""
-        if straight_level(body, base, R[:, 0], self.solver.finger.length) > MISSES:
-            return None, None, None, None
+        state to continue from); force None when the plane misses the bird."""
         cut = body.cut(base, R)
         if cut is None:
             return None, None, None, None
@@ -326,8 +325,9 @@ class FingerForces:
         centre = np.array([y[0], 0.0, y[1]])
         for i, gf in enumerate(self.grasper.fingers):
             force = None
-            if self.active(i, t):
-                base, R = self.frame(i, t)
+            base, R = self.frame(i, t) if self.active(i, t) else (None, None)
+            if base is not None and \
+                    straight_level(body, base, R[:, 0], gf.finger.length) <= MISSES:
                 # continue from the latest solution, trial or committed: the nearest
                 # in time (trials keep the committed friction); or, for a model whose
                 # friction is solved with the contact (spatial), always from the
@@ -337,7 +337,7 @@ class FingerForces:
                 force, p_w, sol, cont = model.solve(
                     body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
                     commit)
-            else:
+            elif base is None:
                 self.skipped += 1
             if force is None:                       # out of reach: no contact problem
                 self.trials[i] = None
