@@ -48,12 +48,15 @@ def stiffness_space(*groups: str, lo: float = 0.5, hi: float = 1.5) -> DesignSpa
                                        for g in groups])
 
 
-def short_problem_file(path: Path, variables: dict, **solver) -> Path:
+def short_problem_file(path: Path, variables: dict, model_check: str = "none",
+                       **solver) -> Path:
     """Write a design problem on the short grasp (cap: the baseline's peak,
-    10 ms grid) to ``path`` (JSON is YAML); ``solver``: further settings."""
+    10 ms grid) to ``path`` (JSON is YAML); ``solver``: further settings.
+    No spatial model check unless asked for (12 s CPU of background runs;
+    tests/test_reports.py's design run has it)."""
     scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
     path.write_text(json.dumps({"kind": "design", "scene": scene, "cap": "baseline",
-                                "variables": variables,
+                                "variables": variables, "model_check": model_check,
                                 "solver": {"time_step": 0.01, **solver}}))
     return path
 

@@ -181,7 +181,9 @@ def design_run(tmp_path_factory):
 def test_design_report_has_every_section_and_matches_result(design_run):
     status, out = design_run
     r, result = read(out), json.loads((out / "result.json").read_text())
-    assert r.sections == ["problem", "verification", *GRASP_SECTIONS, "convergence", "reproduce"]
+    checked = result["status"] in ("verified", "failed verification")   # an optimum to check
+    assert r.sections == ["problem", "verification", *GRASP_SECTIONS,
+                          *(["model-check"] if checked else []), "convergence", "reproduce"]
     assert list(r.figures) == GRASP_FIGURES + ["fig-convergence"]
     passed = result["verification"]["passed"]
     assert (status == 0) == passed
@@ -198,6 +200,16 @@ def test_design_report_has_every_section_and_matches_result(design_run):
     optimiser = r.column("verification-table", "optimiser or limit")
     assert close(optimiser[0], v["optimiser_hold_time_s"]) and close(optimiser[1], v["cap_N"])
     assert len(r.tables["history-table"]) - 1 == len(result["solver"]["history"])
+    # the spatial model check: both designs' runs in the table, the cap's rule
+    # (the baseline's peak) resolved on the spatial baseline
+    check = result["model_check"] if checked else None
+    if check:
+        bird = check["birds"][0]
+        holds = r.column("model-check-table", "hold (s)")
+        assert close(holds[0], bird["baseline"]["hold_time_s"])
+        assert close(holds[1], bird["optimum"]["hold_time_s"])
+        assert bird["cap_N"] == bird["baseline"]["max_finger_force_N"]
+        assert check["finger_model"] == "spatial" and bird["optimum"]["ok"]
 
 
 def test_design_report_draws_the_pareto_curve(design_run, tmp_path):

@@ -9,10 +9,10 @@ reproduction report says so and why; those are not asserted here."""
 import numpy as np
 import pytest
 
-from design.reproduce.grasp import SPATIAL_NODES, football_setup, mean_bird_setup
+from design.reproduce.grasp import football_setup, mean_bird_setup
 from design.reproduce.grasp_rows import net_lift, passes, touched
 from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.solve.grasp.simulation import SPATIAL_NODES, simulate_grasp
 from tests import prefetch
 
 #: keys of this module's runs for the prefetch worker (tests/prefetch.py)

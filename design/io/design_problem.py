@@ -16,6 +16,8 @@ bounds, the bruise cap, the design rules and the solver settings.
       objective: worst         # worst (the shortest hold) | mean (weighted by ``weight``)
       birds: [models/birds/small_1_20kg.yaml, {bird: models/birds/large_2_30kg.yaml, weight: 2}]
     multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
+    model_check: spatial       # the default: baseline and optimum also run with the spatial
+                               # finger (design/solve/optimize/model_check.py); none: not
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}
 
@@ -35,6 +37,7 @@ from design.io.files import resolve
 from design.io.grasp_scene import GraspScene, read_bird
 from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
+from design.solve.optimize.model_check import CHECK_MODEL
 from design.solve.optimize.population import AGGREGATES
 from design.solve.optimize.transcription import NLPSettings, Rules
 from design.solve.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
@@ -99,6 +102,8 @@ class DesignProblem:
     population: PopulationSpec | None = None
     #: the loop from several starting designs (design/solve/optimize/multistart.py)
     multistart: MultistartSpec = MultistartSpec()
+    #: the finger model baseline and optimum are also simulated with, or ``none``
+    model_check: str = CHECK_MODEL
 
     @property
     def pareto(self) -> bool:
@@ -124,7 +129,10 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         if "population" in data else None
     multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
         else MultistartSpec()
-    if not reader.ok or None in (scene, variables, caps, rules, settings, multistart) or \
+    model_check = reader.choice(data, "model_check", "", (CHECK_MODEL, "none"),
+                                default=CHECK_MODEL)
+    if not reader.ok or None in (scene, variables, caps, rules, settings, multistart,
+                                 model_check) or \
             ("population" in data and population is None):
         return None
     # the loop's simulations use the scene's integrator, no looser than the
@@ -133,7 +141,7 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     settings = replace(settings, simulator=replace(
         given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol)))
     return DesignProblem(name, scene, variables, caps, rules, settings,
-                         data.get("description", ""), population, multistart)
+                         data.get("description", ""), population, multistart, model_check)
 
 
 def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:

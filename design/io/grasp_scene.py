@@ -205,8 +205,8 @@ class GraspScene:
     duration: float
     settings: GraspSettings
     description: str = ""
-    #: ``spatial`` (the finger as a rod bending both ways, the default) or
-    #: ``planar`` (the thesis's: rigid out of its plane, in-plane force only)
+    #: ``spatial`` (the finger as a rod bending both ways) or
+    #: ``planar`` (the thesis's, the default: rigid out of its plane, in-plane force only)
     finger_model: str = "planar"
 
 

@@ -29,7 +29,7 @@ KINDS = {
     "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
               ("finger_models", "mounts", "friction", "legs", "finger_model", "solver"), read_grasp),
     "design": (("scene", "variables"), ("cap", "rules", "solver", "population",
-                                             "multistart"), read_design),
+                                             "multistart", "model_check"), read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)
 _COMMON = ("kind", "name", "description")

@@ -117,6 +117,30 @@ def multistart_section(page: Page, multistart: dict) -> None:
     page.table(multistart["starts"], "Every start", "starts-table")
 
 
+def model_check_section(page: Page, check: dict) -> None:
+    """Baseline and optimum simulated again with the spatial finger model."""
+    page.section("The design on the spatial finger model", "model-check")
+    h = check["hold_time_s"]
+    page.text(f"The optimiser and its verification model the fingers as the thesis does "
+              f"({check['design_model']}: bending in their own planes only). Baseline and "
+              f"optimum were simulated again, the same scene with the fingers as rods "
+              f"bending both ways ({check['finger_model']}, {check['contact_nodes']} "
+              f"collocation intervals), with the cap's rule applied to that model's own "
+              f"baseline peak. Hold: baseline {h['baseline']:.4f} s, optimum "
+              f"{h['optimum']:.4f} s; "
+              + ("the optimum's gain survives." if check["gain_survives"] else
+                 "the optimum's gain does NOT survive: "
+                 + ("its hold is shorter. " if not check["holds_at_least_as_long"] else "")
+                 + ("it breaks the cap." if not check["within_cap"] else "")))
+    page.table([{"bird": b["bird"], "design": label, "hold (s)": r["hold_time_s"],
+                 "peak (N)": r["max_finger_force_N"], "peak finger": r["max_finger_force_finger"],
+                 "cap (N)": b["cap_N"], "CPU (s)": r["cpu_time_s"]}
+                for b in check["birds"] for label in ("baseline", "optimum")
+                for r in [b[label]]], "Spatial finger model", "model-check-table")
+    if check["model_warnings"]:
+        page.text("Validity problems of the spatial runs: " + "; ".join(check["model_warnings"]))
+
+
 def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     """``baseline`` and ``optimum`` are the independent (fine) simulations."""
     page = Page(f"Design: {result['name']}")
@@ -161,6 +185,8 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     page.table(summary_rows(baseline, "baseline") + summary_rows(optimum, "optimum"),
                "Baseline and optimum, both from the independent simulation", "summary-table")
     grasp_figures(page, {"baseline": baseline, "optimum": optimum}, v["cap_N"])
+    if result.get("model_check"):
+        model_check_section(page, result["model_check"])
     page.section("Optimiser convergence", "convergence")
     history = result["solver"]["history"]
     page.table([{"outer iteration": h["iteration"], "trust region": h["radius"],

@@ -13,7 +13,7 @@ from design.io.grasp_scene import GraspSettings, read_bird, read_conveyor, read_
 from design.io.reader import Reader
 from design.physics.bird import Conveyor, Legs, belt_motion
 from design.physics.clearance import clearance, matching_tilt
-from design.solve.grasp.simulation import GraspSetup
+from design.solve.grasp.simulation import SPATIAL_NODES, GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
 OMEGA = 20 * 2 * np.pi / 60
@@ -23,10 +23,6 @@ MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
 #: at the contacts lies up to 0.8-0.97 along the fingers' stiff axes, beyond
 #: the planar model's limit (design/solve/grasp/validity.py)
 VALIDATION_MODEL = "spatial"
-#: the spatial rod's collocation intervals: 3 change hold and peak by under
-#: 5e-6 (relative) against 10, at 0.45x the time of the default 6
-#: (benchmarks/spatial_mesh.py); the planar finger keeps the default
-SPATIAL_NODES = 3
 #: Table 5-3's 0.6 s from X0 (Figures 5-5 to 5-9: -0.075 to +0.15 m); the
 #: football's one and a half drum cycles of video (§5.3)
 MEAN_DURATION, FOOTBALL_DURATION = 0.6, 1.6

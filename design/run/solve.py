@@ -31,7 +31,9 @@ from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.profile import RESULT, SETUP, STUDY, VERIFICATION, Profile
+from design.solve.optimize.model_check import ModelCheck, check_text
+from design.solve.optimize.profile import (MODEL_CHECK, RESULT, SETUP, STUDY, VERIFICATION,
+                                           Profile)
 from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solve.optimize.population import Member, Population
@@ -91,6 +93,13 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     verified design; a population also gets its single-bird comparison.
     The cases run through design/study (``study``: where, and the case
     store); a study of one chain runs in this process."""
+    with ModelCheck(problem.settings.simulator) if problem.model_check != "none" \
+            else nullcontext() as check:
+        return _run(problem, progress, study, check)
+
+
+def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions | None,
+         check: ModelCheck | None) -> RunOutput:
     t0 = time.perf_counter()
     profile = Profile()
     say = progress or (lambda message: None)
@@ -99,6 +108,8 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     population = population_of_problem(problem, space)
     settings = problem.settings
     d0 = space.scale(space.base_values)
+    if check:
+        check.submit(BASELINE, population, d0)
     say("simulating the baseline at 4x the optimiser's resolution"
         + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
@@ -110,7 +121,8 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     if chains == 1:
         options = replace(options, workers=1, scheduler=None)
     local = options.workers == 1 and scheduler_address(options) is None
-    task = partial(solve_case, problem, progress if local and chains == 1 else None)
+    task = partial(solve_case, problem, progress if local and chains == 1 else None,
+                   check if local else None)
     # in this process the cases' own profiles add up to the study's time;
     # on workers it is one phase of this process
     with nullcontext() if local else profile.phase(STUDY):
@@ -122,7 +134,7 @@ def run(problem: DesignProblem, progress: Progress | None = None,
             profile.merge(_PROFILES.pop(key))
     try:
         output = _assemble(problem, space, population, cases, results, baseline, caps,
-                           profile, t0)
+                           profile, t0, check)
     finally:
         for key in results:             # none left for a later run's case of this key
             _FINE.pop(key, None)
@@ -132,10 +144,11 @@ def run(problem: DesignProblem, progress: Progress | None = None,
 
 def _assemble(problem: DesignProblem, space: DesignSpace, population: Population,
               cases: list[Case], results: dict, baseline: Scored, caps: list[np.ndarray],
-              profile: Profile, t0: float) -> RunOutput:
+              profile: Profile, t0: float, check: ModelCheck | None) -> RunOutput:
     """The run's output from its cases' results: per cap the best verified
-    case, a multistart's optima, a population's comparison. A failed case
-    fails the run (:class:`StudyFailed`)."""
+    case, a multistart's optima, a population's comparison, the first cap's
+    design on the spatial finger model (``check``). A failed case fails the
+    run (:class:`StudyFailed`)."""
     settings = problem.settings
     failed = {k: r for k, r in results.items() if r["status"] in CASE_FAILED}
     if failed:
@@ -152,9 +165,15 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
         finals[k] = _verified(population, best, results[best], settings, profile)
         entries[k].pop("d")
+    model_check = None
+    if check and entries[0]["status"] in (VERIFIED, FAILED):     # else no optimum to check
+        check.submit(entries[0]["case"], population, finals[0].d)
+        with profile.phase(MODEL_CHECK):
+            model_check = check.result(population, problem.caps[0],
+                                       optimum=entries[0]["case"])
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
-                         baseline, t0)
+                         baseline, t0, model_check)
     if problem.population:
         output.result["population"] = population_comparison(
             space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
@@ -168,6 +187,8 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
 NO_DESIGN = "no design (optimiser error)"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
+#: the model check's label for the baseline design
+BASELINE = "baseline"
 #: the profiles and fine simulations of the cases this process ran (the
 #: engine returns JSON; the report needs the simulations themselves)
 _PROFILES: dict[str, Profile] = {}
@@ -197,12 +218,13 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
     return cases
 
 
-def solve_case(problem: DesignProblem, progress: Progress | None, case: Case,
-               upstream: dict | None) -> dict:
+def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCheck | None,
+               case: Case, upstream: dict | None) -> dict:
     """One case of :func:`design_cases`: the design loop from the case's
     start (or the upstream cap's optimum), its certification and its 4x
     finer verification; the result as result.json's entry for a cap, with
-    the scaled design ``d``."""
+    the scaled design ``d``. ``check``: where the first cap's design starts
+    its spatial runs, before its verification (this process's cases only)."""
     say = progress or (lambda message: None)
     space = design_space(problem)
     population = population_of_problem(problem, space)
@@ -218,6 +240,8 @@ def solve_case(problem: DesignProblem, progress: Progress | None, case: Case,
     outcome = optimise(population, caps, settings, problem.rules, None if first else start,
                        progress, anchor=upstream is not None)
     certify(population, outcome, settings, problem.rules, progress)
+    if check and k == 0:
+        check.submit(case.key, population, outcome.best.d)
     say("verifying at 4x finer resolution")
     with outcome.profile.phase(VERIFICATION):
         fine = verify(population, outcome.best.d, settings)
@@ -322,7 +346,7 @@ def problem_digest(problem: DesignProblem) -> str:
 
 
 def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], fine: Scored,
-            baseline: Scored, t0: float) -> RunOutput:
+            baseline: Scored, t0: float, model_check: dict | None) -> RunOutput:
     """The run's result, tables and files; the first cap's entry is the
     primary one (its design, verified as ``fine``, is reported)."""
     primary = entries[0]
@@ -342,6 +366,7 @@ def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], fin
                      "max_finger_force_N": baseline.peak,
                      "max_finger_force_finger": baseline.run.summary["max_finger_force_finger"],
                      "design": {v.name: v.baseline for v in space.variables}},
+        "model_check": model_check,
         "wall_time_s": time.perf_counter() - t0,
     }
     if problem.pareto:
@@ -382,9 +407,10 @@ def status_line(result: dict) -> str:
                 f"{v['hold_time_s']:.4f} s, {peak}")
     caveat = " (by a model outside its validity)" if status == VERIFIED and \
         v["model_warnings"] else ""
+    check = f"; {check_text(result['model_check'])}" if result.get("model_check") else ""
     return (f"{status}{caveat}: hold {v['hold_time_s']:.4f} s in the independent simulation "
             f"(optimiser {result['objective']['hold_time_s']:.4f} s; baseline "
-            f"{b['hold_time_s']:.4f} s), {peak}")
+            f"{b['hold_time_s']:.4f} s), {peak}{check}")
 
 
 def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: Scored,

@@ -15,6 +15,12 @@ from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, 
 from design.solve.grasp.validity import contact_validity
 
 
+#: the spatial rod's collocation intervals: 3 change hold and peak by under
+#: 5e-6 (relative) against 10, at 0.45x the time of the default 6
+#: (benchmarks/spatial_mesh.py); the planar finger keeps the default
+SPATIAL_NODES = 3
+
+
 @dataclass(frozen=True)
 class GraspSetup:
     """The physical system and its start (SI)."""
@@ -28,7 +34,7 @@ class GraspSetup:
     conveyor_friction: float
     legs: Legs
     duration: float
-    #: the fingers' contact model: ``spatial`` (rod, default) or ``planar`` (thesis)
+    #: the fingers' contact model: ``spatial`` (rod) or ``planar`` (thesis, default)
     finger_model: str = "planar"
 
 

@@ -64,13 +64,16 @@ OPTIMISER, VIEWS = "optimiser NLPs", "fixed-design views"
 CONSTRUCTION, IPOPT, READ_BACK = "construction", "Ipopt", "solution read-back"
 VERIFICATION = "verification simulations (4x finer)"
 RESULT = "result assembly"
+#: waiting for the spatial model check's background runs (their own CPU
+#: time is in result.json's model_check)
+MODEL_CHECK = "spatial model check (wait)"
 #: a study's cases while they run on Dask workers (their own phases are theirs)
 STUDY = "study cases on workers"
 UNACCOUNTED = "unaccounted"
 PHASES = [SETUP, SIMULATIONS,
           *(f"{group}: {step}" for group in (OPTIMISER, VIEWS)
             for step in (CONSTRUCTION, IPOPT, READ_BACK)),
-          VERIFICATION, RESULT]
+          VERIFICATION, MODEL_CHECK, RESULT]
 #: the rootfinders' row (their time is inside nlp_g and nlp_jac_g)
 ROOTFINDERS = "contact rootfinder solves"
 

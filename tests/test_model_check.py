@@ -1,0 +1,90 @@
+"""The design on the spatial finger model (design/solve/optimize/model_check.py):
+its runs in the background process are the spatial simulation itself, its
+verdict follows the cap's rule on the spatial baseline, and closing it stops
+a run in progress."""
+
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from design.io.design_problem import Cap
+from design.io.scene import load_scene
+from design.run.solve import design_space
+from design.solve.grasp.simulation import simulate_grasp
+from design.solve.optimize.model_check import ModelCheck, check_text, compare, spatial_summary
+from design.solve.optimize.population import Member, Population
+from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from design.solve.optimize.variables import DesignSpace
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def placed_bird(duration: float) -> DesignSpace:
+    """The main problem's space (the mean bird placed on finger 4a), cut to
+    ``duration`` s: 0.08 s is 1.6 s CPU of spatial rod and finger 4a presses
+    about 30 N in it."""
+    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    return DesignSpace(replace(space.baseline, duration=duration), space.variables)
+
+
+def test_the_background_run_is_the_spatial_simulation():
+    """The same numbers as the spatial simulation in this process, and not
+    the planar model's: finger 4a's peak differs by 0.27 N between the two."""
+    space = placed_bird(0.08)
+    d0 = space.scale(space.base_values)
+    with ModelCheck(LOOP_SIMULATOR) as check:
+        check.submit("baseline", Population.of(space), d0)
+        (background,) = check.summaries("baseline")
+    here = spatial_summary(space.setup(d0), LOOP_SIMULATOR)
+    for key in ("hold_time_s", "max_finger_force_N", "max_finger_force_time_s"):
+        assert background[key] == here[key]
+    planar = simulate_grasp(space.setup(d0), LOOP_SIMULATOR).summary
+    assert abs(planar["max_finger_force_N"] - here["max_finger_force_N"]) > 0.1
+
+
+def test_closing_stops_a_run_in_progress():
+    """Ctrl-C or a failed case closes the check: the background run (9 s of
+    spatial rod here) is stopped, not waited for."""
+    space = placed_bird(1.0)
+    check = ModelCheck(LOOP_SIMULATOR)
+    check.submit("baseline", Population.of(space), space.scale(space.base_values))
+    time.sleep(1.0)                          # the process is importing or running
+    processes = list(check._pool._processes.values())
+    t0 = time.perf_counter()
+    check.close()
+    for process in processes:
+        process.join(5.0)
+        assert not process.is_alive()
+    assert time.perf_counter() - t0 < 5.0
+
+
+def run(hold: float, peak: float, warnings=()) -> dict:
+    return {"hold_time_s": hold, "max_finger_force_N": peak, "max_finger_force_finger": "4a",
+            "model_warnings": list(warnings), "cpu_time_s": 1.0, "ok": True}
+
+
+TWO = Population((Member("small", None), Member("large", None)), "worst")
+
+
+@pytest.mark.parametrize("cap, optimum, survives, why", [
+    # the baseline's peak as the rule: each bird's cap is its spatial baseline peak
+    (Cap(relative=1.0), [run(0.30, 19.0), run(0.25, 29.0)], True, ""),
+    # the population's hold is the worst bird's: 0.19 s < 0.20 s
+    (Cap(relative=1.0), [run(0.19, 19.0), run(0.40, 29.0)], False, "shorter hold"),
+    # 0.9 x 30 N = 27 N for the large bird, which presses 29 N
+    (Cap(relative=0.9), [run(0.30, 15.0), run(0.30, 29.0)], False, "over the cap"),
+    # newtons stay newtons; within the verification's 1 % tolerance
+    (Cap(value=25.0), [run(0.30, 25.2), run(0.30, 24.0)], True, ""),
+])
+def test_the_verdict_applies_the_caps_rule_to_the_spatial_baseline(cap, optimum, survives,
+                                                                     why):
+    base = [run(0.20, 20.0), run(0.22, 30.0, ["finger 5a passed 9 mm through the belt"])]
+    check = compare(TWO, cap, base, optimum, LOOP_SIMULATOR)
+    assert check["gain_survives"] is survives
+    assert check["caps_N"] == pytest.approx([cap.resolve(20.0), cap.resolve(30.0)])
+    assert check["hold_time_s"]["baseline"] == 0.20
+    assert check["model_warnings"] == ["baseline (large): finger 5a passed 9 mm through the belt"]
+    text = check_text(check)
+    assert ("the gain survives" in text) is survives and why in text
