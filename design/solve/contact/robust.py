@@ -70,6 +70,38 @@ MAX_NEWTON_ITERATIONS = 20
 MAX_STEP_ITERATIONS = 12
 
 
+def follow(state, step: Callable, clear: Callable[[], bool], max_steps: int):
+    """Continue a solved contact ``state`` from t = 0 (its own parameters) to
+    t = 1 in steps that halve on failure and double on success.
+    ``step(state, t)`` solves at t from ``state``: the new state, None on
+    failure, ``"base"`` (the contact reached the finger's base) or
+    ``"release"`` (the normal force would pull); ``clear()``: whether the
+    straight finger is clear of the target, so that a release ends the
+    contact. Returns (state, "") or (None, why)."""
+    t, h = 0.0, 1.0
+    for _ in range(max_steps):
+        if t >= 1.0:
+            return state, ""
+        t_new = min(1.0, t + h)
+        new = step(state, t_new)
+        if new is None:
+            h /= 2
+            if h < 1e-7:
+                return None, f"continuation stalled at {t:.6f} of the step"
+            continue
+        if new == "base":
+            return None, BASE_REACHED
+        if new == "release":
+            if clear():
+                return None, "released"
+            h /= 2
+            if h < 1e-7:
+                return None, "the normal force would pull the finger into the object"
+            continue
+        state, t, h = new, t_new, min(2 * h, 1.0)
+    return None, f"no convergence in {max_steps} continuation steps"
+
+
 @dataclass
 class _State:
     """A solved contact: mode, unknowns, and the parameters they solve."""
@@ -362,31 +394,10 @@ class RobustContact:
 
     def _follow(self, state: _State, path: Callable[[float], tuple[Ellipse, float]]):
         """Continue ``state`` along ``path(t)`` = (ellipse, τµ), t from 0 (the
-        state's) to 1, in steps that halve on failure and double on success."""
+        state's) to 1 (:func:`follow`)."""
         target = path(1.0)[0]
-        t, step = 0.0, 1.0
-        for _ in range(self.max_steps):
-            if t >= 1.0:
-                return state, ""
-            t_new = min(1.0, t + step)
-            new = self._step(state, *path(t_new))
-            if new is None:
-                step /= 2
-                if step < 1e-7:
-                    return None, f"continuation stalled at {t:.6f} of the step"
-                continue
-            if new == "base":
-                return None, BASE_REACHED
-            if new == "release":
-                # the object pulls away: contact is lost if the straight finger is clear
-                if segment_overlap(target, self.finger.length) >= 0.0:
-                    return None, "released"
-                step /= 2
-                if step < 1e-7:
-                    return None, "force would pull the finger into the object"
-                continue
-            state, t, step = new, t_new, min(2 * step, 1.0)
-        return None, f"no convergence in {self.max_steps} continuation steps"
+        return follow(state, lambda s, t: self._step(s, *path(t)),
+                      lambda: segment_overlap(target, self.finger.length) >= 0.0, self.max_steps)
 
     def _step(self, state: _State, ell: Ellipse, tau_mu: float):
         """Newton at new parameters from ``state``, with mode switches; None on failure."""

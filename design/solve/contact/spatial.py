@@ -33,7 +33,7 @@ from design.physics.beam import Finger
 from design.solve.beam.collocation import adapted_widths
 from design.physics.beam import PointLoad, straight_solution
 from design.solve.beam.rod import RodStiffness
-from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, PENETRATION_TOL
+from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, PENETRATION_TOL, follow
 from design.solve.contact.spatial_equations import MODES, spatial_transcription
 
 #: the straight finger enters the object over less than grazing_shift's grid
@@ -355,32 +355,17 @@ class SpatialContact:
         return self._continue(state, quadric, friction)
 
     def _continue(self, state: SpatialState, target: Quadric, friction: np.ndarray):
-        """Continue ``state`` to the target object and friction in adaptive steps."""
+        """Continue ``state`` to the target object and friction in adaptive
+        steps (:func:`~design.solve.contact.robust.follow`)."""
         p0 = np.concatenate([state.quadric.params, state.friction])
         p1 = np.concatenate([target.params, friction])
-        t, step = 0.0, 1.0
-        for _ in range(self.max_steps):
-            if t >= 1.0:
-                return state, ""
-            t_new = min(1.0, t + step)
-            p = p0 + t_new * (p1 - p0)
-            new = self._step(state, Quadric.from_params(p[:9]), p[9:])
-            if new is None:
-                step /= 2
-                if step < 1e-7:
-                    return None, f"continuation stalled at {t:.6f} of the step"
-                continue
-            if new == "base":
-                return None, BASE_REACHED
-            if new == "release":
-                if segment_level(target, self.finger.length) >= 0.0:
-                    return None, "released"
-                step /= 2
-                if step < 1e-7:
-                    return None, "the normal force would pull the finger into the object"
-                continue
-            state, t, step = new, t_new, min(2 * step, 1.0)
-        return None, f"no convergence in {self.max_steps} continuation steps"
+
+        def step(s: SpatialState, t: float):
+            p = p0 + t * (p1 - p0)
+            return self._step(s, Quadric.from_params(p[:9]), p[9:])
+
+        return follow(state, step, lambda: segment_level(target, self.finger.length) >= 0.0,
+                      self.max_steps)
 
     def _step(self, state: SpatialState, quadric: Quadric, friction: np.ndarray):
         """Newton at new parameters from ``state``, with mode switches; None on failure."""
