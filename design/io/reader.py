@@ -88,10 +88,7 @@ class Reader:
         """Read a scalar with units and check it lies in the accepted range."""
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         return self._scalar(data[key], path, dimension, lo, hi, lo_open, hi_open)
 
     def quantities(self, data: Mapping, key: str, field: str, dimension: str, *,
@@ -101,10 +98,7 @@ class Reader:
         """Read a scalar or a non-empty list of scalars (a sweep)."""
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         raw = data[key]
         if isinstance(raw, list):
             if not raw:
@@ -121,10 +115,7 @@ class Reader:
         """Read one vector ``[x, y]`` or a list of them (a sequence of poses)."""
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         raw = data[key]
         if isinstance(raw, list) and raw and not isinstance(raw[0], list):
             raw = [raw]
@@ -150,10 +141,7 @@ class Reader:
         path = join(field, key)
         options = list(options)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, f"required but missing (one of: {', '.join(options)})")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default, f" (one of: {', '.join(options)})")
         value = data[key]
         if value not in options:
             self.add(path, f"'{value}' is not one of: {', '.join(options)}"
@@ -166,10 +154,7 @@ class Reader:
         """Read an integer in ``[lo, hi]``."""
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         value = data[key]
         if isinstance(value, bool) or not isinstance(value, int):
             self.add(path, f"expected an integer in {interval(lo, hi, False, False)}, "
@@ -184,10 +169,7 @@ class Reader:
     def boolean(self, data: Mapping, key: str, field: str, default: object = REQUIRED) -> bool | None:
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         if not isinstance(data[key], bool):
             self.add(path, f"expected true or false, got {data[key]!r}")
             return None
@@ -196,14 +178,19 @@ class Reader:
     def text(self, data: Mapping, key: str, field: str, default: object = REQUIRED) -> str | None:
         path = join(field, key)
         if key not in data:
-            if default is REQUIRED:
-                self.add(path, "required but missing")
-                return None
-            return default  # type: ignore[return-value]
+            return self._default(path, default)
         if not isinstance(data[key], str):
             self.add(path, f"expected a string, got {_kind(data[key])}")
             return None
         return data[key]
+
+    def _default(self, path: str, default: object, hint: str = "") -> object:
+        """A key's value when it is absent: its default, or None and a
+        problem when it is required (``hint``: what it may be)."""
+        if default is REQUIRED:
+            self.add(path, f"required but missing{hint}")
+            return None
+        return default
 
     def _scalar(self, raw: object, path: str, dimension: str, lo: float | None,
                 hi: float | None, lo_open: bool, hi_open: bool) -> float | None:
