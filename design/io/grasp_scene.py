@@ -33,6 +33,7 @@ from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import FingerMount
 from design.solve.grasp.fingers import FINGER_MODELS
 from design.solve.grasp.integrate import INTEGRATORS, STEPPERS, IntegratorSettings
+from design.solve.grasp.simulation import GraspSetup
 
 _MODEL_KEYS = ("kind", "name", "description", "source", "note")
 
@@ -190,24 +191,13 @@ class GraspSettings:
 
 
 @dataclass(frozen=True)
-class GraspScene:
-    """Everything a grasp simulation needs (SI units)."""
+class GraspScene(GraspSetup):
+    """A grasp scene file: the physical system (:class:`GraspSetup`, SI) with
+    its name, description and the simulator's settings."""
 
-    name: str
-    grasper: Grasper
-    bird: Bird
-    conveyor: Conveyor
-    drum_speed: float
-    start_x: float
-    finger_friction: float
-    conveyor_friction: float
-    legs: Legs
-    duration: float
-    settings: GraspSettings
+    name: str = ""
+    settings: GraspSettings = field(default_factory=GraspSettings)
     description: str = ""
-    #: ``spatial`` (the finger as a rod bending both ways) or
-    #: ``planar`` (the thesis's, the default: rigid out of its plane, in-plane force only)
-    finger_model: str = "planar"
 
 
 def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSettings | None:
@@ -295,5 +285,5 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
     if not reader.ok or None in (grasper, bird, conveyor, omega, x0, mu_f, mu_c, k, c, duration,
                                  settings, finger_model):
         return None
-    return GraspScene(name, grasper, bird, conveyor, omega, x0, mu_f, mu_c, Legs(k, c), duration,
-                      settings, data.get("description", ""), finger_model)
+    return GraspScene(grasper, bird, conveyor, omega, x0, mu_f, mu_c, Legs(k, c), duration,
+                      finger_model, name, settings, data.get("description", ""))

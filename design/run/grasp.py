@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import fields
+
 from design import __version__
 from design.io.grasp_scene import GraspScene
 from design.run import Progress, RunOutput
@@ -9,9 +11,8 @@ from design.solve.grasp.simulation import GraspRun, GraspSetup, simulate_grasp
 
 
 def setup_of(scene: GraspScene) -> GraspSetup:
-    return GraspSetup(scene.grasper, scene.bird, scene.conveyor, scene.drum_speed,
-                      scene.start_x, scene.finger_friction, scene.conveyor_friction, scene.legs,
-                      scene.duration, scene.finger_model)
+    """The scene's physical system alone (its name and settings dropped)."""
+    return GraspSetup(**{f.name: getattr(scene, f.name) for f in fields(GraspSetup)})
 
 
 def timeseries(run: GraspRun) -> list[dict]:
