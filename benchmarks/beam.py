@@ -22,7 +22,6 @@ Prints a table and writes benchmarks/results/beam.json.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import time
@@ -31,8 +30,8 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_bvp
 
+from benchmarks.results_file import write_results
 from design.io.fingers import read_finger
-from design.io.results import jsonable
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
 from design.reproduce.grasp import load_model
@@ -238,9 +237,7 @@ def main() -> None:
     args = parser.parse_args()
     result = run(args.quick)
     print_table(result)
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps(jsonable(result), indent=1) + "\n")
-    print(f"\nwrote {RESULTS}")
+    write_results(RESULTS, result)
 
 
 if __name__ == "__main__":

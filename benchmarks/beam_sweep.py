@@ -30,7 +30,6 @@ Prints a table and writes benchmarks/results/beam_sweep.json.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import platform
 import time
@@ -41,8 +40,8 @@ import numpy as np
 
 import design
 from benchmarks.beam import bvp_sweep
+from benchmarks.results_file import write_results
 from design.io.fingers import read_finger
-from design.io.results import jsonable
 from design.physics.beam import PointLoad
 from design.reproduce.grasp import load_model
 from design.solve import compiled
@@ -173,9 +172,7 @@ def main() -> None:
     args = parser.parse_args()
     result = run(args.repeat)
     print_table(result)
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps(jsonable(result), indent=1) + "\n")
-    print(f"\nwrote {RESULTS}")
+    write_results(RESULTS, result)
 
 
 if __name__ == "__main__":

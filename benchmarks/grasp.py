@@ -23,12 +23,11 @@ Prints a table and writes benchmarks/results/grasp.json.
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 from pathlib import Path
 
-from design.io.results import jsonable
+from benchmarks.results_file import write_results
 from design.reproduce.grasp import thesis_setup
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import simulate_grasp
@@ -120,9 +119,7 @@ def main() -> None:
     print(f"reach filter (2 s cycle): {rf['with_s']:.2f} s with, {rf['without_s']:.2f} s without "
           f"({rf['saved_pct']:.0f}% saved; {rf['contact_solves_with']} against "
           f"{rf['contact_solves_without']} contact solves)")
-    RESULTS.parent.mkdir(parents=True, exist_ok=True)
-    RESULTS.write_text(json.dumps(jsonable(result), indent=1) + "\n")
-    print(f"wrote {RESULTS}")
+    write_results(RESULTS, result)
 
 
 if __name__ == "__main__":

@@ -95,8 +95,8 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
+from benchmarks.results_file import write_results
 from design.api import check, solve
-from design.io.results import jsonable
 from design.run.solve import design_space
 from design.solve.optimize.profile import profile_text
 from design.solve.optimize.schedule import schedule_of
@@ -430,9 +430,7 @@ def main() -> None:
         data["main_job"] = main_job()
     elif "main_job" in old:
         data["main_job"] = old["main_job"]
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(jsonable(data), indent=1) + "\n")
-    print(RESULTS)
+    write_results(RESULTS, data)
 
 
 if __name__ == "__main__":

@@ -19,13 +19,12 @@ minutes on 2 cores).
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 import time
 from pathlib import Path
 
-from design.io.results import jsonable
+from benchmarks.results_file import write_results
 from design.reproduce.grasp import football_setup, mean_bird_setup
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import simulate_grasp
@@ -75,13 +74,11 @@ def main() -> None:
                   f"{r['hold_error_s']:+9.1e} {r['max_finger_force_N']:8.3f} "
                   f"{r['peak_relative_error']:+9.1e} {1e3 * r['centre_rise_m']:8.2f} "
                   f"{r['cpu_s']:6.1f} {r['cpu_over_default']:8.2f}x{mark}", flush=True)
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps(jsonable({
+    write_results(RESULTS, {
         "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
                     "load_average_at_start": load, "load_average_at_end": os.getloadavg()},
         "reference_intervals": REFERENCE, "default_intervals": DEFAULT, "degree": 4,
-        "scenes": scenes}), indent=1) + "\n")
-    print(RESULTS)
+        "scenes": scenes})
 
 
 if __name__ == "__main__":
