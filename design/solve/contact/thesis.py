@@ -65,6 +65,19 @@ class _Mirrored:
         side = SIDES.get(sliding, 1)
         return (ell if side > 0 else ell.mirrored()), side
 
+    def _start(self, pose: FingerPose, ellipse: Ellipse, sliding: str):
+        """Both algorithms' start: (the ellipse in the push frame, the side,
+        the parabola guess (x, y, a) of eq. 3.11), or the solution when the
+        straight finger misses or no parabola touches."""
+        length = self.finger.length
+        ell, side = self._push_frame(pose, ellipse, sliding)
+        if segment_overlap(ell, length) >= 0:
+            return no_contact(pose, length, "the straight finger misses the object")
+        guess = parabola_guess(ell, length)
+        if guess is None:
+            return no_contact(pose, length, "no parabola touches the object", converged=False)
+        return ell, side, guess
+
 
 class AlgorithmI(_Mirrored):
     """Thesis Algorithm I: Frisch-Fay with an effective EI and a fixed-point step β.
@@ -101,12 +114,10 @@ class AlgorithmI(_Mirrored):
     def solve(self, pose: FingerPose, ellipse: Ellipse, sliding: str = "push",
               motion: Motion | None = None) -> ContactSolution:
         length = self.finger.length
-        ell, side = self._push_frame(pose, ellipse, sliding)
-        if segment_overlap(ell, length) >= 0:
-            return no_contact(pose, length, "the straight finger misses the object")
-        guess = parabola_guess(ell, length)
-        if guess is None:
-            return no_contact(pose, length, "no parabola touches the object", converged=False)
+        start = self._start(pose, ellipse, sliding)
+        if isinstance(start, ContactSolution):
+            return start
+        ell, side, guess = start
         x_i, y_i = guess[0], guess[1]
         trace = []
         converged, its, state = False, 0, None
@@ -219,13 +230,10 @@ class AlgorithmII(_Mirrored):
     def solve(self, pose: FingerPose, ellipse: Ellipse, sliding: str = "push",
               motion: Motion | None = None) -> ContactSolution:
         length, n = self.finger.length, self.nodes
-        ell, side = self._push_frame(pose, ellipse, sliding)
-        if segment_overlap(ell, length) >= 0:
-            return no_contact(pose, length, "the straight finger misses the object")
-        guess = parabola_guess(ell, length)
-        if guess is None:
-            return no_contact(pose, length, "no parabola touches the object", converged=False)
-        x0, y0, a = guess
+        start = self._start(pose, ellipse, sliding)
+        if isinstance(start, ContactSolution):
+            return start
+        ell, side, (x0, y0, a) = start
         # parabola: slope 2 a x; arc length (3.11); force from Frisch-Fay with EI at the base
         psi = np.arctan(2 * a * x0 * np.linspace(0, 1, n + 2))
         arc = float(np.trapezoid(np.sqrt(1 + (2 * a * np.linspace(0, x0, 200)) ** 2),
