@@ -8,6 +8,7 @@ from matplotlib.figure import Figure
 from design.report.grasp import grasp_figures, reproduce_section, summary_rows
 from design.report.page import Page
 from design.solve.grasp.simulation import GraspRun
+from design.solve.optimize.model_check import check_text
 from design.solve.optimize.profile import profile_rows
 
 
@@ -147,6 +148,7 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     v, b = result["verification"], result["baseline"]
     ratio = v["hold_time_s"] / b["hold_time_s"] if b["hold_time_s"] > 0 else float("inf")
     status = result["status"]
+    check = f" Then, {check_text(result['model_check'])}." if result.get("model_check") else ""
     if status == "no improvement found":
         page.banner(f"NO IMPROVEMENT FOUND: {result['message']} (hold {v['hold_time_s']:.4f} "
                     f"s, peak finger force {v['max_finger_force_N']:.2f} N, cap "
@@ -155,14 +157,15 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
         page.banner(f"VERIFIED BY A MODEL OUTSIDE ITS VALIDITY: hold {v['hold_time_s']:.4f} s "
                     f"({ratio:.2f}x the baseline's {b['hold_time_s']:.4f} s), peak finger force "
                     f"{v['max_finger_force_N']:.2f} N under the {v['cap_N']:.2f} N cap; "
-                    f"{'; '.join(v['model_warnings'])}.", "failed")
+                    f"{'; '.join(v['model_warnings'])}.{check}", "failed")
     elif status == "verified":
         page.banner(f"VERIFIED: hold {v['hold_time_s']:.4f} s ({ratio:.2f}x the baseline's "
                     f"{b['hold_time_s']:.4f} s), peak finger force {v['max_finger_force_N']:.2f} N "
-                    f"under the {v['cap_N']:.2f} N cap: {result['message']}.", "passed")
+                    f"under the {v['cap_N']:.2f} N cap: {result['message']}.{check}",
+                    "passed" if not check or result["model_check"]["gain_survives"] else "failed")
     else:
         page.banner(f"{status.upper()}: {result['message']}. Do not use this "
-                    "design without reading the verification table.", "failed")
+                    f"design without reading the verification table.{check}", "failed")
     page.section("The problem", "problem")
     page.text(result.get("description") or "")
     page.text(f"Maximise the longest interval in which the belt does not support the bird "
