@@ -56,8 +56,9 @@ def test_units_and_caps_are_read_in_si():
      "variables.groups.lower.stiffness_scale", "must be > 0"),
     ({"solver": {"time_step": 2}}, "solver.time_step", "outside the accepted range"),
     ({"scene": "no_such_scene.yaml"}, "scene", "cannot find"),
-    ({"scene": str(ROOT / "problems" / "grasp_football.yaml")}, "scene",
-     "a design scene must use finger_model: planar"),
+    # a spatial scene has no other model to check against
+    ({"scene": str(ROOT / "problems" / "grasp_football.yaml"), "model_check": "spatial"},
+     "model_check", "'spatial' is not one of: none"),
 ])
 def test_bad_problem_is_rejected_with_file_and_field(change, field, text):
     with pytest.raises(ProblemFileError) as err:

@@ -19,7 +19,8 @@ bounds, the bruise cap, the design rules and the solver settings.
     model_check: spatial       # the default: baseline and optimum also run with the spatial
                                # finger (design/solve/optimize/model_check.py); none: not
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
-             trust_region: 0.15, cap_margin: 0.25, ipopt: {}}
+             trust_region: 0.15, cap_margin: 0.25, ipopt: {}}   # beam_intervals: the
+                               # finger mesh, by default the scene's contact_nodes
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
@@ -129,8 +130,10 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         if "population" in data else None
     multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
         else MultistartSpec()
-    model_check = reader.choice(data, "model_check", "", (CHECK_MODEL, "none"),
-                                default=CHECK_MODEL)
+    # the check runs the other finger model: none for a scene that is spatial already
+    checks = (CHECK_MODEL, "none") if scene is None or scene.finger_model != CHECK_MODEL \
+        else ("none",)
+    model_check = reader.choice(data, "model_check", "", checks, default=checks[0])
     if not reader.ok or None in (scene, variables, caps, rules, settings, multistart,
                                  model_check) or \
             ("population" in data and population is None):
@@ -140,6 +143,11 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     given, tight = scene.settings.integrator, LOOP_SIMULATOR
     settings = replace(settings, simulator=replace(
         given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol)))
+    solver = data.get("solver", {})
+    if "beam_intervals" not in solver:       # the finger mesh: the scene's unless given
+        nodes = scene.settings.contact_nodes
+        settings = replace(settings, nlp=replace(settings.nlp, beam_intervals=nodes),
+                           contact_nodes=nodes)
     return DesignProblem(name, scene, variables, caps, rules, settings,
                          data.get("description", ""), population, multistart, model_check)
 
@@ -168,10 +176,6 @@ def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
         return None
     if not isinstance(scene, GraspScene):
         reader.add("scene", "must be a grasp scene (kind: grasp)")
-        return None
-    if scene.finger_model != "planar":
-        reader.add("scene", f"finger_model '{scene.finger_model}': the optimiser models the "
-                            f"fingers as planar; a design scene must use finger_model: planar")
         return None
     return scene
 

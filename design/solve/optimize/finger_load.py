@@ -7,13 +7,22 @@ a CasADi rootfinder, the force mapped back to the world and doubled for the
 mirror finger. Built once per finger and contact mode; called at every stage
 of the time grid.
 
-Inputs: bird pose (X, Z, θ) (m, rad), time t (s), the finger's design
-fp = (angle, height, drum radius, φx, φy, length) (rad, m), the drums'
-g = (spacing, speed) (m, rad/s), the stiffness scale k, the signed friction
-τµ and the rootfinder's start z0. Outputs: the load on the bird from both
-drums (Q_X, Q_Z, T_Y) (N, N, N m), the contact force magnitude clipped at
-zero (N; a contact that would pull lets go) and the contact's unknowns z
-(an output to read, declared not differentiable).
+Two finger models (the simulator's, design/solve/grasp/fingers.py):
+``planar``, the thesis's, whose section of the bird is an ellipse and
+whose force lies in the finger's bending plane, and ``spatial``, the rod
+bending both ways against the ellipsoid with regularised Coulomb friction
+against the finger's sliding (a smooth function of the bird's state and
+time, so that it needs no friction sense from the schedule).
+
+Inputs (:attr:`StageModel.sizes`): planar, the bird pose (X, Z, θ) (m, rad)
+and the signed friction τµ; spatial, the bird's whole state (X, Z, θ and
+their rates; the rates set the sliding); both, the time t (s), the
+finger's design fp = (angle, height, drum radius, φx, φy, length) (rad,
+m), the drums' g = (spacing, speed) (m, rad/s), the stiffness scale k and
+the rootfinder's start z0. Outputs: the load on the bird from both drums
+(Q_X, Q_Z, T_Y) (N, N, N m), the contact force's magnitude with the normal
+force clipped at zero (N; a contact that would pull lets go) and the
+contact's unknowns z (an output to read, declared not differentiable).
 
 How it is evaluated (issue 13): the function is three calls, the kinematics
 x -> q (SX), the rootfinder (z0, q) -> z and the loads (x, z) -> outputs
@@ -54,50 +63,156 @@ import numpy as np
 
 from design.physics.bird import Bird
 from design.physics.grasper import GraspFinger, Grasper
-from design.physics.kinematics import finger_frame, section
+from design.physics.kinematics import finger_frame, rot_y, section
+from design.solve.beam.rod import RodStiffness
 from design.solve.compiled import compiled
 from design.solve.contact.equations import MODES, contact_transcription
 from design.solve.contact.robust import RobustContact
+from design.solve.contact.spatial import SpatialContact
+from design.solve.contact.spatial_equations import spatial_transcription
+from design.solve.grasp.fingers import FRICTION_SPEED, RATE_STEP
 
 #: Newton tolerance and iteration limit inside the NLP
 TOLERANCE, MAX_ITER = 1e-10, 30
-#: the inputs and outputs of a finger's function
-INPUTS = ["pose", "t", "fp", "g", "k", "tau_mu", "z0"]
+#: the outputs of a finger's function; its inputs are the model's sizes, then z0
 OUTPUTS = ["load", "force", "z"]
 DIFFERENTIABLE = [True, True, False]
-#: sizes of the differentiable inputs (all but z0), in INPUTS' order
-SIZES = {"pose": 3, "t": 1, "fp": 6, "g": 2, "k": 1, "tau_mu": 1}
-#: index of the constants in c: grasper x, tilt, bird η, λ, γ, EI_ref, then widths, params
-N_FIXED = 6
+
+
+def _loads(base, R, point_f, force_f, centre):
+    """The load on the bird (Q_X, Q_Z, T_Y) of a finger and its mirror on
+    the left drum (the same X and Z, Y mirrored) from the force on the bird
+    ``force_f`` at ``point_f``, both in the finger frame (base, R)."""
+    f_w = R @ force_f
+    r = base + R @ point_f - centre
+    return 2 * ca.vertcat(f_w[0], f_w[2], r[2] * f_w[0] - r[0] * f_w[2])
+
+
+class PlanarStage:
+    """The thesis's finger (design/solve/grasp/fingers.py's PlanarFinger):
+    the bending plane's section of the bird, the planar contact in it, the
+    in-plane force with the schedule's friction sense τµ."""
+
+    name = "planar"
+    #: sizes of the differentiable inputs, in order
+    sizes = {"pose": 3, "t": 1, "fp": 6, "g": 2, "k": 1, "tau_mu": 1}
+    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, then widths, stiffness params
+    n_fixed = 6
+    #: the implicit-function adjoint's linear solver (the residual Jacobian's sparsity)
+    solver = "qr"
+
+    def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
+                 intervals: int, degree: int):
+        # the simulator's mesh and reference rigidity, so that its z are guesses here
+        reference = RobustContact(gf.finger, friction, intervals, degree)
+        self.stiffness, self.intervals, self.degree = gf.finger.stiffness, intervals, degree
+        self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
+                                          bird.gamma, reference.ei_ref], reference.widths,
+                                         self.stiffness.params])
+
+    def transcription(self, mode: str):
+        return contact_transcription(self.stiffness, self.intervals, self.degree, mode,
+                                     ellipse="conic")
+
+    @classmethod
+    def expressions(cls, tr, parts: dict, z, c):
+        """(q, load, force) of one stage in SX."""
+        pose, t, fp, g = parts["pose"], parts["t"], parts["fp"], parts["g"]
+        K = tr.beam.K
+        gx, tilt, eta, lam, gamma, ei_ref = (c[i] for i in range(cls.n_fixed))
+        widths, params = c[cls.n_fixed:cls.n_fixed + K], c[cls.n_fixed + K:]
+        base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
+        u0, B, _ = section((eta, lam, gamma), (pose[0], 0.0, pose[1]), pose[2], base, R)
+        q = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], parts["tau_mu"], widths,
+                       params)
+        post = tr.post(z, q)[0]
+        x_l, y_l, alpha = post[0], post[1], post[4]
+        pressing = ca.fmax(parts["k"] * post[3], 0.0)
+        force_f = ca.vertcat(pressing * ca.cos(alpha), -pressing * ca.sin(alpha), 0.0)
+        load = _loads(base, R, ca.vertcat(x_l, y_l, 0.0), force_f,
+                      ca.vertcat(pose[0], 0.0, pose[1]))
+        return q, load, pressing
+
+
+class SpatialStage:
+    """The finger as a spatial rod (design/solve/grasp/fingers.py's
+    SpatialFinger): the bird's ellipsoid as a quadric in the finger frame,
+    the friction law from the rigid finger's sliding over the bird (the
+    simulator's forward difference over RATE_STEP, so the same numbers),
+    the force along the surface normal plus friction."""
+
+    name = "spatial"
+    sizes = {"state": 6, "t": 1, "fp": 6, "g": 2, "k": 1}
+    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, µ, ε, then widths, stiffness params
+    n_fixed = 8
+    #: dense LU, as the spatial rootfinder's (spatial_equations.py: 39 % full)
+    solver = "lapacklu"
+
+    def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
+                 intervals: int, degree: int):
+        reference = SpatialContact(gf.finger, intervals, degree)
+        self.stiffness = RodStiffness.of(gf.finger)
+        self.intervals, self.degree = intervals, degree
+        self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
+                                          bird.gamma, reference.ei_ref, friction,
+                                          FRICTION_SPEED], reference.widths,
+                                         self.stiffness.params])
+
+    def transcription(self, mode: str):
+        return spatial_transcription(self.stiffness, self.intervals, self.degree, mode)
+
+    @classmethod
+    def expressions(cls, tr, parts: dict, z, c):
+        state, t, fp, g = parts["state"], parts["t"], parts["fp"], parts["g"]
+        K = tr.rod.K
+        gx, tilt, eta, lam, gamma, ei_ref, mu, eps = (c[i] for i in range(cls.n_fixed))
+        widths, params = c[cls.n_fixed:cls.n_fixed + K], c[cls.n_fixed + K:]
+        def frame(time):
+            return finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], time, gx, tilt)
+
+        base, R = frame(t)
+        base2, R2 = frame(t + RATE_STEP)
+        centre = ca.vertcat(state[0], 0.0, state[1])
+        centre2 = centre + RATE_STEP * ca.vertcat(state[3], 0.0, state[4])
+        Rb, Rb2 = rot_y(state[2]), rot_y(state[2] + RATE_STEP * state[5])
+        body = ca.diag(ca.vertcat(1 / eta ** 2, 1 / lam ** 2, 1 / gamma ** 2))
+        c_f, Q_f = R.T @ (centre - base), R.T @ Rb @ body @ Rb.T @ R
+        # the bird's material velocity relative to the finger frame at p (finger
+        # frame): v(p) = (R2ᵀ (centre2 + Rb2 Rbᵀ (base + R p - centre) - base2) - p) / dt
+        # = v0 + G p; the law takes the finger's sliding over the bird, -v
+        carry = Rb2 @ Rb.T
+        v0 = R2.T @ (centre2 + carry @ (base - centre) - base2) / RATE_STEP
+        G = (R2.T @ carry @ R - ca.DM.eye(3)) / RATE_STEP
+        law = ca.vertcat(ca.DM.zeros(3), mu, eps, -v0, ca.vec((-G).T))
+        quadric = ca.vertcat(c_f, Q_f[0, 0], Q_f[0, 1], Q_f[0, 2], Q_f[1, 1], Q_f[1, 2],
+                             Q_f[2, 2])
+        q = ca.vertcat(fp[5], ei_ref, quadric, law, widths, params)
+        post = tr.post(z, q)[0]
+        point, normal_force, direction = post[0:3], post[3], post[7:10] + post[16:19]
+        pressing = ca.fmax(parts["k"] * normal_force, 0.0)
+        load = _loads(base, R, point, -pressing * direction, centre)
+        return q, load, pressing * ca.norm_2(direction)
+
+
+#: the stage models by name (a grasp scene's ``finger_model``)
+STAGE_MODELS = {m.name: m for m in (PlanarStage, SpatialStage)}
+#: the planar model's inputs, for callers that build its stages by hand
+SIZES = PlanarStage.sizes
 
 
 class StageFunctions:
-    """The generic SX parts of one contact transcription (stiffness
-    structure, mesh, mode): kinematics, loads and their Jacobian blocks, as
-    functions of x = (pose, t, fp, g, k, τµ), z and the constants c; with
-    the rootfinder that uses the (compiled) residual Jacobian."""
+    """The generic SX parts of one contact transcription (finger model,
+    stiffness structure, mesh, mode): kinematics, loads and their Jacobian
+    blocks, as functions of x (the model's differentiable inputs), z and the
+    constants c; with the transcription's rootfinder."""
 
-    def __init__(self, tr, n_c: int):
-        self.tr = tr
-        nx = sum(SIZES.values())
-        x, z, c = ca.SX.sym("x", nx), ca.SX.sym("z", tr.n_z), ca.SX.sym("c", n_c)
-        parts = dict(zip(SIZES, ca.vertsplit(x, np.cumsum([0, *SIZES.values()]).tolist())))
-        pose, t, fp, g = parts["pose"], parts["t"], parts["fp"], parts["g"]
-        scale, tau_mu = parts["k"], parts["tau_mu"]
-        K = tr.beam.K
-        gx, tilt, eta, lam, gamma, ei_ref = (c[i] for i in range(N_FIXED))
-        widths, params = c[N_FIXED:N_FIXED + K], c[N_FIXED + K:]
-        base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
-        centre = ca.vertcat(pose[0], 0.0, pose[1])
-        u0, B, _ = section((eta, lam, gamma), (pose[0], 0.0, pose[1]), pose[2], base, R)
-        q = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], tau_mu, widths, params)
-        post = tr.post(z, q)[0]
-        x_l, y_l, force, alpha = post[0], post[1], scale * post[3], post[4]
-        pressing = ca.fmax(force, 0.0)
-        plane = R[:, :2]
-        f_w = plane @ ca.vertcat(pressing * ca.cos(alpha), -pressing * ca.sin(alpha))
-        r = base + plane @ ca.vertcat(x_l, y_l) - centre
-        load = 2 * ca.vertcat(f_w[0], f_w[2], r[2] * f_w[0] - r[0] * f_w[2])
+    def __init__(self, tr, n_c: int, model=PlanarStage):
+        self.tr, self.model = tr, model
+        sizes = model.sizes
+        x, z, c = ca.SX.sym("x", sum(sizes.values())), ca.SX.sym("z", tr.n_z), \
+            ca.SX.sym("c", n_c)
+        parts = dict(zip(sizes, ca.vertsplit(x, np.cumsum([0, *sizes.values()]).tolist())))
+        q, load, pressing = model.expressions(tr, parts, z, c)
         out = ca.vertcat(load, pressing)
         name = tr.residual.name()
         self.pre = ca.Function(f"{name}_q", [x, c], [q], ["x", "c"], ["q"])
@@ -114,69 +229,70 @@ class StageFunctions:
         #: whether the SX parts run compiled, and the compiler or why not
         self.compiled, self.compile_reason = done.compiled, done.reason
         # the transcription's own Newton (its residual Jacobian compiled the same way)
-        self.rootfinder = tr.rootfinder(TOLERANCE, MAX_ITER, error_on_fail=True)
+        self.rootfinder = tr.rootfinder(TOLERANCE, MAX_ITER, error_on_fail=True,
+                                        compiled_jacobian=True)
 
 
 _STAGES: dict = {}
 
 
-def stage_functions(tr, n_c: int) -> StageFunctions:
-    key = (id(tr), n_c)
+def stage_functions(tr, n_c: int, model=PlanarStage) -> StageFunctions:
+    key = (id(tr), n_c, model.name)
     if key not in _STAGES:
-        _STAGES[key] = StageFunctions(tr, n_c)
+        _STAGES[key] = StageFunctions(tr, n_c, model)
     return _STAGES[key]
 
 
 class FingerLoad:
-    """``functions[mode]`` for one finger (mode ``interior`` or ``tip``);
-    ``compiled[mode]``: (whether its SX parts run compiled, the compiler
-    command or why not)."""
+    """``functions[mode]`` for one finger (mode ``interior`` or ``tip``) of
+    the finger model ``model`` (:data:`STAGE_MODELS`); ``compiled[mode]``:
+    (whether its SX parts run compiled, the compiler command or why not)."""
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
-                 intervals: int, degree: int = 4):
-        # the simulator's mesh and reference rigidity, so that its z are guesses here
-        reference = RobustContact(gf.finger, friction, intervals, degree)
-        self.ei_ref, self.widths = reference.ei_ref, reference.widths
+                 intervals: int, degree: int = 4, model: str = "planar"):
+        self.model = STAGE_MODELS[model](gf, grasper, bird, friction, intervals, degree)
+        self.sizes = self.model.sizes
+        #: the function's inputs, in order
+        self.inputs = [*self.sizes, "z0"]
         self.n_z, self.transcriptions, self.compiled = {}, {}, {}
-        self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
-                                          bird.gamma, self.ei_ref], self.widths,
-                                         gf.finger.stiffness.params])
+        self.constants = self.model.constants
         self._jacobians: dict = {}
         self._stages: dict = {}
         self._batches: dict = {}
-        self.functions = {m: self._build(gf, intervals, degree, m) for m in MODES}
+        self.functions = {m: self._build(gf, m) for m in MODES}
 
-    def _build(self, gf, intervals, degree, mode) -> ca.Function:
-        tr = contact_transcription(gf.finger.stiffness, intervals, degree, mode, ellipse="conic")
+    def _build(self, gf, mode) -> ca.Function:
+        tr = self.model.transcription(mode)
         self.n_z[mode], self.transcriptions[mode] = tr.n_z, tr
-        st = stage_functions(tr, self.constants.size)
+        st = stage_functions(tr, self.constants.size, type(self.model))
         self.compiled[mode] = st.compiled, st.compile_reason
         self._stages[mode] = st
+        sizes, inputs = self.sizes, self.inputs
         c = ca.DM(self.constants)
-        args = [ca.MX.sym(n, SIZES[n]) for n in SIZES]
+        args = [ca.MX.sym(n, sizes[n]) for n in sizes]
         z0 = ca.MX.sym("z0", tr.n_z)
         x = ca.vertcat(*args)
         z = st.rootfinder(z0, st.pre(x, c))
         load, force = st.loads(x, z, c)
         # the Jacobian at the solution, by the adjoint of the contact: inputs,
         # then the nominal outputs (the solution z is the last)
-        x_j = [ca.MX.sym(n, SIZES[n]) for n in SIZES]
+        x_j = [ca.MX.sym(n, sizes[n]) for n in sizes]
         outs = [ca.MX.sym(f"out_{n}", s) for n, s in zip(OUTPUTS, (3, 1, tr.n_z))]
         r_z, r_x, o_z, o_x = st.blocks(ca.vertcat(*x_j), outs[-1], c)
-        adjoint = ca.solve(r_z.T, o_z.T, "qr")
+        adjoint = ca.solve(r_z.T, o_z.T, self.model.solver)
         d_out = o_x - ca.mtimes(adjoint.T, r_x)
-        cuts = np.cumsum([0, *SIZES.values()]).tolist()
+        cuts = np.cumsum([0, *sizes.values()]).tolist()
         blocks = []
         for row in ca.vertsplit(d_out, [0, 3, 4]):
             blocks += ca.horzsplit(row, cuts) + [ca.MX(row.size1(), tr.n_z)]
         # z is the contact's state, an output to read, not to differentiate
-        blocks += [ca.MX(tr.n_z, n) for n in [*SIZES.values(), tr.n_z]]
+        blocks += [ca.MX(tr.n_z, n) for n in [*sizes.values(), tr.n_z]]
         name = f"finger_{gf.name}_{mode}"
         jac = ca.Function(f"jac_{name}", [*x_j, ca.MX.sym("z0", tr.n_z), *outs], blocks,
-                          [*INPUTS, *(f"out_{o}" for o in OUTPUTS)],
-                          [f"jac_{o}_{i}" for o in OUTPUTS for i in INPUTS])
+                          [*inputs, *(f"out_{o}" for o in OUTPUTS)],
+                          [f"jac_{o}_{i}" for o in OUTPUTS for i in inputs])
         self._jacobians[mode] = jac
-        return ca.Function(name, [*args, z0], [load, force, z], INPUTS, OUTPUTS,
+        return ca.Function(name, [*args, z0], [load, force, z], inputs, OUTPUTS,
                            {"custom_jacobian": jac, "jac_penalty": 0, "enable_forward": False,
                             "enable_reverse": False,
                             "is_diff_out": DIFFERENTIABLE})
@@ -196,7 +312,7 @@ class FingerLoad:
         if key not in self._batches:
             f, jac = self.functions[mode], self._jacobians[mode]
             name = f"{f.name()}_x{n}"
-            ins = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(INPUTS)]
+            ins = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
             outs = [ca.MX.sym(f"out_{o}", f.size1_out(k), n) for k, o in enumerate(OUTPUTS)]
             blocks = jac.map(n)(*ins, *outs)
             # the stage blocks side by side hold the block-diagonal matrix's
@@ -208,13 +324,13 @@ class FingerLoad:
             # the stages: kinematics, the contacts (solved once per point, see
             # _Roots), loads; the same operations as n calls of functions[mode]
             st, c = self._stages[mode], ca.DM(self.constants)
-            ins_f = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(INPUTS)]
-            x = ca.vertcat(*ins_f[:len(SIZES)])
+            ins_f = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
+            x = ca.vertcat(*ins_f[:len(self.sizes)])
             roots = _Roots(f"{name}_roots", st.rootfinder.map(n), st.tr.n_q)
             z = roots(ins_f[-1], st.pre.map(n)(x, c))
             load, force = st.loads.map(n)(x, z, c)
             self._batches[key] = (ca.Function(
-                name, ins_f, [load, force, z], INPUTS, OUTPUTS,
+                name, ins_f, [load, force, z], self.inputs, OUTPUTS,
                 {"custom_jacobian": jac_n, "jac_penalty": 0, "enable_forward": False,
                  "enable_reverse": False, "is_diff_out": DIFFERENTIABLE}), roots)
         return self._batches[key][0]

@@ -37,7 +37,9 @@ STAGES = (0.0, 0.5, 0.5, 1.0)
 @dataclass(frozen=True)
 class FingerContact:
     """A finger's contact at one stage: mode ``interior`` or ``tip``, signed
-    friction τµ, and the collocation unknowns z of the simulation as a guess."""
+    friction τµ (planar fingers; 0 for spatial ones, whose friction follows
+    their sliding), and the collocation unknowns z of the simulation as a
+    guess."""
 
     mode: str
     tau_mu: float
@@ -178,6 +180,7 @@ def _contacts(recs, times, t: float) -> list[FingerContact | None]:
         if s is None or not s.contact or "z" not in s.extras:
             out.append(None)
         else:
-            out.append(FingerContact(s.extras["mode"], s.extras["friction_ratio"],
+            # the spatial finger's friction follows its sliding: no sense to keep
+            out.append(FingerContact(s.extras["mode"], s.extras.get("friction_ratio", 0.0),
                                      np.asarray(s.extras["z"], float)))
     return out

@@ -150,7 +150,8 @@ class DesignNLP:
                 for i, c in enumerate(st) if c is not None}
         self.fingers = {i: FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
                                       setup.finger_friction, settings.beam_intervals,
-                                      settings.degree) for i in sorted(used)}
+                                      settings.degree, setup.finger_model)
+                        for i in sorted(used)}
         self._modes = {}
         #: (whether every finger function's SX parts run compiled, the reasons)
         states = [m for f in self.fingers.values() for m in f.compiled.values()]
@@ -205,12 +206,14 @@ class DesignNLP:
             for (i, mode), group in calls.items():
                 f = self.fingers[i].batch(mode, len(group))
                 fp, scale = design[i]
-                load, force, _ = f(ca.horzcat(*[states[j, k][:3] for j, k, _ in group]),
-                                   ca.horzcat(*[times[j, k] for j, k, _ in group]),
-                                   ca.repmat(fp, 1, len(group)), ca.repmat(g, 1, len(group)),
-                                   ca.repmat(scale, 1, len(group)),
-                                   ca.DM([[cc.tau_mu for _, _, cc in group]]),
-                                   ca.DM(np.column_stack([cc.z for _, _, cc in group])))
+                state = ca.horzcat(*[states[j, k] for j, k, _ in group])
+                given = {"pose": state[:3, :], "state": state,
+                         "t": ca.horzcat(*[times[j, k] for j, k, _ in group]),
+                         "fp": ca.repmat(fp, 1, len(group)), "g": ca.repmat(g, 1, len(group)),
+                         "k": ca.repmat(scale, 1, len(group)),
+                         "tau_mu": ca.DM([[cc.tau_mu for _, _, cc in group]]),
+                         "z0": ca.DM(np.column_stack([cc.z for _, _, cc in group]))}
+                load, force, _ = f(*(given[name] for name in self.fingers[i].inputs))
                 for n, (j, k, _) in enumerate(group):
                     results[j, k, i] = load[:, n], force[0, n]
             for j, k in cells:

@@ -1,0 +1,107 @@
+"""The optimiser's spatial finger (design/solve/optimize/finger_load.py's
+SpatialStage) against the simulator's (design/solve/grasp/fingers.py's
+SpatialFinger): the same contact, load and force from the same state, and
+its explicit Jacobian is CasADi's derivative of the same chain."""
+
+from dataclasses import replace
+from pathlib import Path
+
+import casadi as ca
+import numpy as np
+import pytest
+
+from design.io.scene import load_scene
+from design.run.solve import design_space
+from design.solve.grasp.simulation import SPATIAL_NODES, simulate_grasp
+from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from design.solve.optimize.variables import parameters_of
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def placed():
+    """The main problem's scene with the spatial finger, 0.04 s of it (0.6 s
+    CPU): finger 4a presses the placed mean bird about 14 N (a record at
+    0.034 s), sliding under it with µ = 0.4."""
+    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    setup = replace(space.baseline, duration=0.04, finger_model="spatial")
+    return setup, simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)
+
+
+def stage_inputs(setup, record, i: int) -> dict:
+    """The finger function's inputs for finger i at a simulator record."""
+    v, gf = parameters_of(setup), setup.grasper.fingers[i]
+    key = f"fingers.{gf.design_name}."
+    fp = [v[key + "angle"] + gf.phase, v[key + "height"], gf.mount.radius, v[key + "phi_x"],
+          v[key + "phi_y"], v[key + "length"]]
+    return {"state": record.y, "t": record.t, "fp": fp, "g": [v["spacing"], v["drum_speed"]],
+            "k": 1.0, "z0": record.fingers[i].solution.extras["z"]}
+
+
+@pytest.fixture(scope="module")
+def finger_4a(placed):
+    """Finger 4a's NLP function, interpreted (the formula, not the compiler:
+    compiling it takes about 60 s on an empty cache), with its inputs and
+    the simulator's state at the last record."""
+    from design.solve.optimize.finger_load import FingerLoad
+    setup, run = placed
+    i = [gf.name for gf in setup.grasper.fingers].index("4a")
+    record = run.trajectory.records[-1]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("DESIGN_COMPILE", "0")
+        load = FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
+                          setup.finger_friction, SPATIAL_NODES, 4, "spatial")
+    return load, stage_inputs(setup, record, i), record.fingers[i], record
+
+
+def test_the_nlp_finger_is_the_simulators(finger_4a):
+    """From the simulator's state and contact unknowns, the NLP's finger
+    solves the same contact (z unchanged to 1e-9 of its scale) and gives the
+    simulator's force magnitude and its load on the bird from both drums
+    (the mirror finger: X and Z the same, Y mirrored) to 1e-9 relative: the
+    friction law is the same forward difference of the same frames."""
+    load, inputs, state, _ = finger_4a
+    mode = state.solution.extras["mode"]
+    out, force, z = load.functions[mode](*(inputs[n] for n in load.inputs))
+    z_sim = inputs["z0"]
+    assert np.abs(np.asarray(z).ravel() - z_sim).max() <= 1e-9 * np.abs(z_sim).max()
+    assert state.magnitude > 5.0
+    assert float(force) == pytest.approx(state.magnitude, rel=1e-9)
+    f, r = state.force, state.point - np.array([inputs["state"][0], 0.0, inputs["state"][1]])
+    expected = 2 * np.array([f[0], f[2], r[2] * f[0] - r[0] * f[2]])
+    assert np.allclose(np.asarray(out).ravel(), expected, rtol=1e-9, atol=1e-9 * abs(f).max())
+
+
+def test_the_spatial_jacobian_is_the_rootfinders_derivative(finger_4a, monkeypatch):
+    """The explicit Jacobian (the adjoint of the contact, dense LU) against
+    CasADi's derivative through the rootfinder, in every differentiable
+    input: the state (its rates move the friction), t, the finger's design,
+    the drums and the stiffness scale; to 1e-9 of its largest entry, as the
+    planar finger's (tests/test_compiled.py; measured 4.8e-13: both solve the
+    same contact to its Newton tolerance)."""
+    monkeypatch.setenv("DESIGN_COMPILE", "0")     # CasADi's derivative needs the SX
+    from design.solve.optimize.finger_load import SpatialStage, StageFunctions
+    load, inputs, state, _ = finger_4a
+    mode = state.solution.extras["mode"]
+    F = load.functions[mode]
+    sizes = SpatialStage.sizes
+    st = StageFunctions(load.transcriptions[mode], load.constants.size, SpatialStage)
+    x = ca.MX.sym("x", sum(sizes.values()))
+    z0 = ca.MX.sym("z0", load.n_z[mode])
+    c = ca.DM(load.constants)
+    root = st.tr.rootfinder(1e-12, 30, True)(z0, st.pre(x, c))
+    out = ca.vertcat(*st.loads(x, root, c))
+    reference = ca.Function("reference", [x, z0], [ca.jacobian(out, x)])
+    x0 = ca.vertcat(*[ca.DM(inputs[n]) for n in sizes])
+    ref = np.asarray(ca.densify(reference(x0, inputs["z0"])))
+    values = F(*(inputs[n] for n in load.inputs))
+    blocks = F.jacobian()(*(inputs[n] for n in load.inputs), *values)
+    n_in = len(load.inputs)
+    ours = np.asarray(ca.densify(ca.vertcat(*[ca.horzcat(*blocks[o * n_in:o * n_in + len(sizes)])
+                                              for o in (0, 1)])))
+    scale = np.abs(ref).max()
+    assert scale > 0 and np.abs(ours - ref).max() <= 1e-9 * scale
+    # the rates matter: the friction follows the sliding
+    rates = slice(3, 6)
+    assert np.abs(ref[:, rates]).max() > 1e-3 * scale
