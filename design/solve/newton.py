@@ -114,15 +114,29 @@ class NewtonCache:
         self._make_jacobian, self._jacobian = jacobian, None
         self._built: dict = {}
 
-    def get(self, tolerance: float, max_iter: int, error_on_fail: bool) -> ca.Function:
-        key = (tolerance, max_iter, error_on_fail)
+    def get(self, tolerance: float, max_iter: int, error_on_fail: bool,
+            use_jacobian: bool = True) -> ca.Function:
+        """The rootfinder; ``use_jacobian`` false: with CasADi's own Jacobian
+        even when a ``jacobian`` was given (no compiling for it)."""
+        key = (tolerance, max_iter, error_on_fail, use_jacobian)
         if key not in self._built:
             opts = {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
                     "line_search": True, "linear_solver": self.linear_solver,
                     "show_eval_warnings": False}
-            if self._make_jacobian is not None:
+            if self._make_jacobian is not None and use_jacobian:
                 if self._jacobian is None:
                     self._jacobian = self._make_jacobian()
                 opts["jacobian_function"] = self._jacobian
             self._built[key] = ca.rootfinder(self.name, "newton", self.residual, opts)
         return self._built[key]
+
+
+def compiled_jacobian(residual: ca.Function, name: str) -> ca.Function:
+    """(z, q) -> (∂R/∂z, R) of an SX residual R(z, q) for the Newton steps,
+    compiled when a compiler is there (design/solve/compiled.py; the same
+    operations as CasADi's own, so the same iterates to the last bit)."""
+    from design.solve.compiled import compiled
+    z = ca.SX.sym("z", residual.size1_in(0))
+    q = ca.SX.sym("q", residual.size1_in(1))
+    r = residual(z, q)
+    return compiled([ca.Function(name, [z, q], [ca.jacobian(r, z), r])]).functions[0]

@@ -36,8 +36,7 @@ from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, le
                                     level_conic)
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import BeamTranscription, transcription
-from design.solve.compiled import compiled
-from design.solve.newton import NewtonCache
+from design.solve.newton import NewtonCache, compiled_jacobian
 
 MODES = ("interior", "tip")
 #: ellipse parameterisations: (level, gradient) functions of (x, y, q[ELLIPSE])
@@ -111,23 +110,17 @@ class ContactTranscription:
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
             [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
-        self._newton = NewtonCache(f"contact_{self.mode}_newton", self.residual, "qr",
-                                   self._compiled_jacobian)
-
-    def _compiled_jacobian(self) -> ca.Function:
-        """(z, q) -> (∂R/∂z, R) for the Newton steps, compiled when a compiler
-        is there (design/solve/compiled.py; the same operations as CasADi's
-        own, so the same iterates to the last bit)."""
-        z, q = ca.SX.sym("z", self.n_z), ca.SX.sym("q", self.n_q)
-        r = self.residual(z, q)
-        jac = ca.Function(f"{self.residual.name()}_{self.ellipse}_jac_z", [z, q],
-                          [ca.jacobian(r, z), r])
-        return compiled([jac]).functions[0]
+        self._newton = NewtonCache(
+            f"contact_{self.mode}_newton", self.residual, "qr",
+            lambda: compiled_jacobian(self.residual,
+                                      f"{self.residual.name()}_{self.ellipse}_jac_z"))
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40,
-                   error_on_fail: bool = False) -> ca.Function:
-        """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton)."""
-        return self._newton.get(tolerance, max_iter, error_on_fail)
+                   error_on_fail: bool = False, compiled_jacobian: bool = True
+                   ) -> ca.Function:
+        """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton),
+        its Jacobian compiled (a few seconds once, on an empty cache)."""
+        return self._newton.get(tolerance, max_iter, error_on_fail, compiled_jacobian)
 
     def parameters(self, length: float, ei_ref: float, ellipse: Ellipse, tau_mu: float,
                    widths: np.ndarray, stiffness: Stiffness) -> np.ndarray:
