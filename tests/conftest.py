@@ -50,6 +50,7 @@ def _prefetch_jobs(session) -> list:
     from tests.test_population import TWINS, solve_twins
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
+    from tests.test_spatial_nlp import PLACED_HOLD, placed_hold
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
     from tests.test_validation import (FOOTBALL, MEAN_HARD, MEAN_SOFT, football_run,
                                        mean_bird_run)
@@ -89,6 +90,8 @@ def _prefetch_jobs(session) -> list:
         jobs.append((BEAM_STUDY, beam_study, (folder("tradeoff") / "out",), ()))
     if asked(["tests/test_tradeoff.py::test_grasp_window_keeps"]):
         jobs.append((GRASP_WINDOW, grasp_window_study, (), ()))
+    if asked(["tests/test_spatial_nlp.py::test_the_nlp_calls_the_spatial_finger"]):
+        jobs.append((PLACED_HOLD, placed_hold, (), ()))
     if fixture_used("football"):
         jobs.append((FOOTBALL, football_run, (), ()))
     if fixture_used("mean_soft"):

@@ -1,7 +1,9 @@
 """The optimiser's spatial finger (design/solve/optimize/finger_load.py's
 SpatialStage) against the simulator's (design/solve/grasp/fingers.py's
 SpatialFinger): the same contact, load and force from the same state, and
-its explicit Jacobian is CasADi's derivative of the same chain."""
+its explicit Jacobian is CasADi's derivative of the same chain; and the
+design NLP calls it with each node's whole state (the rates set the
+friction), its time and the design."""
 
 from dataclasses import replace
 from pathlib import Path
@@ -13,10 +15,30 @@ import pytest
 from design.io.scene import load_scene
 from design.run.solve import design_space
 from design.solve.grasp.simulation import SPATIAL_NODES, simulate_grasp
+from design.solve.optimize.schedule import STAGES, schedule_of
+from design.solve.optimize.transcription import DesignNLP, NLPSettings
 from design.solve.optimize.trust_region import LOOP_SIMULATOR
-from design.solve.optimize.variables import parameters_of
+from design.solve.optimize.variables import DesignSpace, parameters_of
+from tests import prefetch
 
 ROOT = Path(__file__).resolve().parents[1]
+#: the prefetch worker's key for :func:`placed_hold`
+PLACED_HOLD = "test_spatial_nlp: placed bird, 0.5 s"
+
+
+def placed_space(duration: float) -> DesignSpace:
+    """The main problem's design space with the spatial finger, cut to ``duration`` s."""
+    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    return DesignSpace(replace(space.baseline, duration=duration, finger_model="spatial"),
+                       space.variables)
+
+
+def placed_hold():
+    """The spatial placed bird over 0.5 s (5-9 s CPU): its hold window
+    [0, 0.44 s] ends in a touch-down, so the optimiser can schedule it."""
+    space = placed_space(0.5)
+    return simulate_grasp(space.setup(space.scale(space.base_values)), LOOP_SIMULATOR,
+                          SPATIAL_NODES)
 
 
 @pytest.fixture(scope="module")
@@ -105,3 +127,42 @@ def test_the_spatial_jacobian_is_the_rootfinders_derivative(finger_4a, monkeypat
     # the rates matter: the friction follows the sliding
     rates = slice(3, 6)
     assert np.abs(ref[:, rates]).max() > 1e-3 * scale
+
+
+def test_the_nlp_calls_the_spatial_finger_with_each_nodes_state(monkeypatch):
+    """At the simulation's own states, every first RK stage's finger force
+    in the NLP (the cap's rows) is the finger function's at that node's
+    whole state, time and the baseline design, to the last bit: the NLP
+    passes the rates the friction needs, not the pose alone."""
+    monkeypatch.setenv("DESIGN_COMPILE", "0")
+    space = placed_space(0.5)
+    run = prefetch.result(PLACED_HOLD, placed_hold)
+    schedule = schedule_of(run, 0.005)
+    nlp = DesignNLP(space, schedule, run, 1e3, NLPSettings(beam_intervals=SPATIAL_NODES))
+    forces = np.asarray(nlp.functions(nlp.x0)[2]).ravel()
+    v, grasper = parameters_of(space.baseline), space.baseline.grasper
+    checked, n, t_phase = 0, 0, schedule.t_start
+    for phase in schedule.phases:
+        h = phase.duration / phase.intervals
+        for k in range(phase.intervals):
+            for s, contacts in enumerate(phase.contacts[k]):
+                for i, contact in enumerate(contacts):
+                    if contact is None:
+                        continue
+                    if STAGES[s] == 0.0 and s == 0:
+                        load = nlp.fingers[i]
+                        gf = grasper.fingers[i]
+                        key = f"fingers.{gf.design_name}."
+                        fp = [v[key + "angle"] + gf.phase, v[key + "height"], gf.mount.radius,
+                              v[key + "phi_x"], v[key + "phi_y"], v[key + "length"]]
+                        inputs = {"state": phase.states[k], "t": t_phase + k * h, "fp": fp,
+                                  "g": [v["spacing"], v["drum_speed"]], "k": 1.0,
+                                  "z0": contact.z}
+                        _, force, _ = load.functions[contact.mode](
+                            *(inputs[name] for name in load.inputs))
+                        assert forces[n] == pytest.approx(float(force), rel=1e-12, abs=1e-12)
+                        checked += 1
+                    n += 1
+        t_phase += phase.duration
+    assert n == forces.size and checked > 50
+    assert forces.max() > 20.0                   # finger 4a holds the bird: real contacts
