@@ -3,6 +3,8 @@ its runs in the background process are the spatial simulation itself, its
 verdict follows the cap's rule on the spatial baseline, and closing it stops
 a run in progress."""
 
+import subprocess
+import sys
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -51,13 +53,10 @@ def test_closing_stops_a_run_in_progress():
     check = ModelCheck(LOOP_SIMULATOR)
     check.submit("baseline", Population.of(space), space.scale(space.base_values))
     time.sleep(1.0)                          # the process is importing or running
-    processes = list(check._pool._processes.values())
+    process = check._process
     t0 = time.perf_counter()
     check.close()
-    for process in processes:
-        process.join(5.0)
-        assert not process.is_alive()
-    assert time.perf_counter() - t0 < 5.0
+    assert process.poll() is not None and time.perf_counter() - t0 < 5.0
 
 
 def run(hold: float, peak: float, warnings=()) -> dict:
@@ -88,3 +87,28 @@ def test_the_verdict_applies_the_caps_rule_to_the_spatial_baseline(cap, optimum,
     assert check["model_warnings"] == ["baseline (large): finger 5a passed 9 mm through the belt"]
     text = check_text(check)
     assert ("the gain survives" in text) is survives and why in text
+
+
+def test_an_unguarded_script_runs_once(tmp_path):
+    """A user's script with no ``if __name__ == "__main__"`` guard that
+    starts the check is not run again by the background process (a
+    multiprocessing child would import it again and run it twice)."""
+    script = tmp_path / "user.py"
+    marks = tmp_path / "marks"
+    script.write_text(
+        "import sys\n"
+        f"open({str(marks)!r}, 'a').write('x')\n"
+        f"sys.path.insert(0, {str(ROOT)!r})\n"
+        "from tests.test_model_check import placed_bird\n"
+        "from design.solve.optimize.model_check import ModelCheck\n"
+        "from design.solve.optimize.population import Population\n"
+        "from design.solve.optimize.trust_region import LOOP_SIMULATOR\n"
+        "space = placed_bird(0.02)\n"
+        "with ModelCheck(LOOP_SIMULATOR) as check:\n"
+        "    check.submit('baseline', Population.of(space), space.scale(space.base_values))\n"
+        "    print(check.summaries('baseline')[0]['max_finger_force_N'])\n")
+    done = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert float(done.stdout) > 20.0                  # finger 4a holds the bird
+    assert marks.read_text() == "x"

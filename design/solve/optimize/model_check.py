@@ -14,16 +14,25 @@ is resolved on the spatial baseline's own peak.
 The spatial runs (6-8 s CPU each on the main problem) go to one background
 process, the baseline's at the start of the run while the optimiser works,
 the optimum's as soon as the design loop has picked it, so that they cost
-the run little wall time on a machine with a free core. A check that fails
-(the simulation raises or ends early) fails the run: no silent gaps.
+the run little wall time on a machine with a free core. The process is a
+fresh interpreter running this module (``python -m``), not a
+multiprocessing child: those import the caller's main script again, which
+would run a user's unguarded ``design.api.solve(...)`` script twice. Tasks
+and results pass as pickles through a private temporary folder. A check
+that fails (the simulation raises or ends early, the process dies) fails
+the run: no silent gaps.
 """
 
 from __future__ import annotations
 
-import multiprocessing
+import os
+import pickle
+import subprocess
+import sys
+import tempfile
 import time
-from concurrent.futures import Future, ProcessPoolExecutor
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -54,15 +63,21 @@ def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
 class ModelCheck:
     """Spatial runs of designs of a population, in a background process.
 
-    ``submit(label, population, d)`` starts every bird's run of the scaled
+    ``submit(label, population, d)`` queues every bird's run of the scaled
     design d; ``result(...)`` waits for a baseline's and an optimum's runs
     and compares them. ``close()`` (or the ``with`` block) stops the
-    process, also on Ctrl-C."""
+    process, also amid a run (Ctrl-C, a failed case): a simulation still
+    running there is not waited for."""
+
+    #: how often a wait looks for a result (s)
+    POLL = 0.02
 
     def __init__(self, integrator: IntegratorSettings):
         self.integrator = integrator
-        self._pool = ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("spawn"))
-        self._runs: dict[str, list[Future]] = {}
+        self._folder = tempfile.TemporaryDirectory(prefix="design-model-check-")
+        self._process: subprocess.Popen | None = None
+        self._runs: dict[str, list[Path]] = {}
+        self._count = 0
 
     def __enter__(self) -> ModelCheck:
         return self
@@ -71,26 +86,59 @@ class ModelCheck:
         self.close()
 
     def close(self) -> None:
-        """Stop the background process, also amid a run (Ctrl-C, a failed
-        case): a simulation still running there is not waited for."""
-        # Python 3.14's ProcessPoolExecutor.terminate_workers; before it, the
-        # same by hand (shutdown forgets the processes, so they are taken first)
-        processes = list((getattr(self._pool, "_processes", None) or {}).values())
-        self._pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
-            process.terminate()
+        if self._process is not None:
+            if self._process.poll() is None:
+                self._process.kill()
+                self._process.wait()
+            self._process.stdin.close()
+        self._folder.cleanup()
+
+    def _worker(self) -> subprocess.Popen:
+        """The background interpreter, started on the first task; it finds
+        this package where this process found it."""
+        if self._process is None:
+            root = str(Path(__file__).resolve().parents[3])
+            env = dict(os.environ)
+            env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
+            log = open(Path(self._folder.name) / "worker.log", "wb")
+            self._process = subprocess.Popen([sys.executable, "-m", __spec__.name],
+                                             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                             stderr=log, env=env)
+            log.close()
+        return self._process
 
     def submit(self, label: str, population, d: np.ndarray) -> None:
-        """Start the spatial runs of design d (scaled) for every bird, once per label."""
-        if label not in self._runs:
-            self._runs[label] = [self._pool.submit(spatial_summary, m.space.setup(d),
-                                                   self.integrator)
-                                 for m in population.members]
+        """Queue the spatial runs of design d (scaled) for every bird, once per label."""
+        if label in self._runs:
+            return
+        worker, paths = self._worker(), []
+        for m in population.members:
+            self._count += 1
+            task = Path(self._folder.name) / f"{self._count}.task"
+            task.write_bytes(pickle.dumps((m.space.setup(d), self.integrator)))
+            worker.stdin.write(f"{task}\n".encode())
+            worker.stdin.flush()
+            paths.append(task.with_suffix(".result"))
+        self._runs[label] = paths
+
+    def _wait(self, path: Path) -> dict:
+        while not path.exists():
+            if self._process.poll() is not None:
+                log = (Path(self._folder.name) / "worker.log").read_text(errors="replace")
+                raise RuntimeError(f"the spatial check's process ended (exit status "
+                                   f"{self._process.returncode}) before its run "
+                                   f"{path.stem}: {log.strip()[-2000:]}")
+            time.sleep(self.POLL)
+        run = pickle.loads(path.read_bytes())
+        if "error" in run:
+            raise RuntimeError(f"the spatial check's run {path.stem} failed: {run['error']}")
+        return run
 
     def summaries(self, label: str) -> list[dict]:
         """Every bird's spatial run of the design submitted as ``label``; a
-        run that ended early fails the check (RuntimeError naming it)."""
-        runs = [f.result() for f in self._runs[label]]
+        run that failed or ended early fails the check (RuntimeError naming
+        it)."""
+        runs = [self._wait(path) for path in self._runs[label]]
         for run in runs:
             if not run["ok"]:
                 raise RuntimeError(f"the spatial check of the {label} design ended early: "
@@ -150,3 +198,23 @@ def check_text(check: dict) -> str:
     own = f" ({n} validity problem(s) of that model's own: result.json model_check)" if n else ""
     return (f"on the spatial finger model: hold {h['baseline']:.4f} -> {h['optimum']:.4f} s, "
             f"peak {peak:.2f} N (cap {cap:.2f} N on its own baseline): {verdict}{own}")
+
+
+def _serve() -> None:
+    """The background process: each line of standard input names a task
+    file (a pickled setup and integrator); its :func:`spatial_summary`, or
+    the error, is written beside it as ``.result`` (renamed into place
+    whole, so that a reader never sees half of it)."""
+    for line in sys.stdin:
+        task = Path(line.strip())
+        try:
+            run = spatial_summary(*pickle.loads(task.read_bytes()))
+        except Exception as exc:                 # noqa: BLE001  reported by the waiting run
+            run = {"error": f"{type(exc).__name__}: {exc}"}
+        partial = task.with_suffix(".partial")
+        partial.write_bytes(pickle.dumps(run))
+        partial.replace(task.with_suffix(".result"))
+
+
+if __name__ == "__main__":
+    _serve()
