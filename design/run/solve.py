@@ -32,8 +32,8 @@ from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.model_check import ModelCheck, check_text
-from design.solve.optimize.profile import (MODEL_CHECK, RESULT, SETUP, STUDY, VERIFICATION,
-                                           Profile)
+from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, SETUP, STUDY,
+                                           VERIFICATION, Profile, clocks)
 from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solve.optimize.population import Member, Population
@@ -123,15 +123,22 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     local = options.workers == 1 and scheduler_address(options) is None
     task = partial(solve_case, problem, progress if local and chains == 1 else None,
                    check if local else None)
-    # in this process the cases' own profiles add up to the study's time;
-    # on workers it is one phase of this process
+    # in this process the cases' own profiles and the engine's rest add up to
+    # the study's time; on workers it is one phase of this process
+    started = clocks()
     with nullcontext() if local else profile.phase(STUDY):
         results = run_study(cases, task, options=options, label=problem.name,
                             progress=None if chains == 1 else StudyProgress(quiet=progress is None),
                             problem_digest=problem_digest(problem))
+    study = [now - then for now, then in zip(clocks(), started)]
+    before = profile.timed()
     for key in results:
         if key in _PROFILES:
             profile.merge(_PROFILES.pop(key))
+    if local:
+        cases_own = [now - then for now, then in zip(profile.timed(), before)]
+        profile.add(CASE_OVERHEAD, max(study[0] - cases_own[0], 0.0), 1,
+                    max(study[1] - cases_own[1], 0.0))
     try:
         output = _assemble(problem, space, population, cases, results, baseline, caps,
                            profile, t0, check)

@@ -69,11 +69,14 @@ RESULT = "result assembly"
 MODEL_CHECK = "spatial model check (wait)"
 #: a study's cases while they run on Dask workers (their own phases are theirs)
 STUDY = "study cases on workers"
+#: a study run in this process: what its cases spend outside their own
+#: phases (the case store's writes, each case's setup and result entry)
+CASE_OVERHEAD = "study engine and case setup"
 UNACCOUNTED = "unaccounted"
 PHASES = [SETUP, SIMULATIONS,
           *(f"{group}: {step}" for group in (OPTIMISER, VIEWS)
             for step in (CONSTRUCTION, IPOPT, READ_BACK)),
-          VERIFICATION, MODEL_CHECK, RESULT]
+          VERIFICATION, CASE_OVERHEAD, MODEL_CHECK, RESULT]
 #: the rootfinders' row (their time is inside nlp_g and nlp_jac_g)
 ROOTFINDERS = "contact rootfinder solves"
 
@@ -206,6 +209,11 @@ class Profile:
         if "post_s" in timings:
             self.add(f"{group}: {READ_BACK}", timings["post_s"], 1,
                      timings.get("post_cpu_s", 0.0))
+
+    def timed(self) -> tuple[float, float]:
+        """Wall and CPU time (s) of all phases so far."""
+        return (sum(p[0] for p in self.phases.values()),
+                sum(p[2] for p in self.phases.values()))
 
     def merge(self, other: Profile) -> None:
         """Add another profile's phases and NLP statistics (not its clock)."""
