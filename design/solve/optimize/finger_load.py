@@ -79,12 +79,10 @@ OUTPUTS = ["load", "force", "z"]
 DIFFERENTIABLE = [True, True, False]
 
 
-def _loads(base, R, point_f, force_f, centre):
+def _loads(f_w, r):
     """The load on the bird (Q_X, Q_Z, T_Y) of a finger and its mirror on
     the left drum (the same X and Z, Y mirrored) from the force on the bird
-    ``force_f`` at ``point_f``, both in the finger frame (base, R)."""
-    f_w = R @ force_f
-    r = base + R @ point_f - centre
+    ``f_w`` at ``r`` from its centre, both in the world frame."""
     return 2 * ca.vertcat(f_w[0], f_w[2], r[2] * f_w[0] - r[0] * f_w[2])
 
 
@@ -122,16 +120,18 @@ class PlanarStage:
         gx, tilt, eta, lam, gamma, ei_ref = (c[i] for i in range(cls.n_fixed))
         widths, params = c[cls.n_fixed:cls.n_fixed + K], c[cls.n_fixed + K:]
         base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
+        centre = ca.vertcat(pose[0], 0.0, pose[1])
         u0, B, _ = section((eta, lam, gamma), (pose[0], 0.0, pose[1]), pose[2], base, R)
         q = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], parts["tau_mu"], widths,
                        params)
         post = tr.post(z, q)[0]
-        x_l, y_l, alpha = post[0], post[1], post[4]
-        pressing = ca.fmax(parts["k"] * post[3], 0.0)
-        force_f = ca.vertcat(pressing * ca.cos(alpha), -pressing * ca.sin(alpha), 0.0)
-        load = _loads(base, R, ca.vertcat(x_l, y_l, 0.0), force_f,
-                      ca.vertcat(pose[0], 0.0, pose[1]))
-        return q, load, pressing
+        x_l, y_l, force, alpha = post[0], post[1], parts["k"] * post[3], post[4]
+        pressing = ca.fmax(force, 0.0)
+        # the force and point in the bending plane (the first two axes of R)
+        plane = R[:, :2]
+        f_w = plane @ ca.vertcat(pressing * ca.cos(alpha), -pressing * ca.sin(alpha))
+        r = base + plane @ ca.vertcat(x_l, y_l) - centre
+        return q, _loads(f_w, r), pressing
 
 
 class SpatialStage:
@@ -190,7 +190,7 @@ class SpatialStage:
         post = tr.post(z, q)[0]
         point, normal_force, direction = post[0:3], post[3], post[7:10] + post[16:19]
         pressing = ca.fmax(parts["k"] * normal_force, 0.0)
-        load = _loads(base, R, point, -pressing * direction, centre)
+        load = _loads(R @ (-pressing * direction), base + R @ point - centre)
         return q, load, pressing * ca.norm_2(direction)
 
 
