@@ -63,15 +63,12 @@ def _prefetch_jobs(session) -> list:
 
     folder = session.config._tmp_path_factory.mktemp
     jobs = []
-    # first the references (11 s), which the test process, reaching them
-    # within seconds, would otherwise wait for; then what the optimiser's
-    # tests compile (7 s on an empty cache; a test that gets there first
-    # compiles it itself, the worker then loads it)
-    if asked(["tests/test_contact_poses.py::test_imposed_side_matches"]):
-        jobs.append((REFERENCES, imposed_side_references, (), ()))
     if asked(["tests/test_compiled_nlp.py", "tests/test_design_solve.py",
               "tests/test_population.py", "tests/test_run_status.py"]):
+        # first: what it compiles, the tests load from the cache instead
         jobs.append((COMPILE, compile_finger_loads, (), ()))
+    if asked(["tests/test_contact_poses.py::test_imposed_side_matches"]):
+        jobs.append((REFERENCES, imposed_side_references, (), ()))
     simulations = prefetch_jobs(SETTINGS)
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
