@@ -22,6 +22,7 @@ from design.report.page import write_report
 from design.run import RunOutput
 from design.solve.contact.spatial import Quadric, SpatialContact
 from design.solve.grasp.fingers import FingerState
+from design.solve.optimize.model_check import compare
 from design.solve.optimize.trust_region import LOOP_SIMULATOR
 from tests import prefetch
 from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
@@ -154,9 +155,40 @@ def test_grasp_report(tmp_path):
 DESIGN_RUN = "tests/test_reports.py: the short design solve"
 
 
-def solve_short_design(tmp: Path) -> int:
+class RecordingCheck:
+    """The spatial model check's interface (design/solve/optimize/model_check.py)
+    without its spatial runs (12 s of CPU on the short grasp, in a third
+    process beside the test process and the prefetch worker): it records the
+    designs the run hands it and answers with made-up runs, the optimum's
+    longer and lighter. The real background runs are tests/test_model_check.py's."""
+
+    submitted: list = []
+
+    def __init__(self, integrator):
+        self.integrator = integrator
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        pass
+
+    def submit(self, label, population, d):
+        RecordingCheck.submitted.append((label, np.asarray(d, float).tolist()))
+
+    def result(self, population, cap_spec, baseline="baseline", optimum="optimum"):
+        def run(hold, peak):
+            return {"hold_time_s": hold, "max_finger_force_N": peak,
+                    "max_finger_force_finger": "1a", "model_warnings": [], "cpu_time_s": 0.0,
+                    "ok": True}
+        return compare(population, cap_spec, [run(0.30, 20.0)], [run(0.31, 19.0)],
+                       self.integrator)
+
+
+def solve_short_design(tmp: Path) -> tuple[int, list]:
     """One short design solve (one outer iteration) written with its report
-    to tmp/out; its exit status. Its simulations are shared with the other
+    to tmp/out; its exit status and the designs it handed the model check
+    (:class:`RecordingCheck`). Its simulations are shared with the other
     tests' (tests/design_cases.py)."""
     problem = {"kind": "design", "name": "short_design", "description": "A short test.",
                "scene": str(short_scene(tmp)), "cap": "baseline",
@@ -164,26 +196,30 @@ def solve_short_design(tmp: Path) -> int:
                "solver": {"time_step": 0.01, "max_iter": 15, "outer_iterations": 1}}
     path = tmp / "problem.yaml"
     path.write_text(json.dumps(problem))
-    with sharing_simulations():
-        return main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
+    RecordingCheck.submitted = []
+    with sharing_simulations(), pytest.MonkeyPatch.context() as patch:
+        patch.setattr("design.run.solve.ModelCheck", RecordingCheck)
+        status = main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
+    return status, RecordingCheck.submitted
 
 
 @pytest.fixture(scope="module")
 def design_run(tmp_path_factory):
-    """:func:`solve_short_design`'s status and output folder: run ahead by the
-    session's prefetch worker (tests/prefetch.py) into the folder it was
-    given, or here."""
+    """:func:`solve_short_design`'s status, output folder and the designs it
+    handed the model check: run ahead by the session's prefetch worker
+    (tests/prefetch.py) into the folder it was given, or here."""
     given = prefetch.scheduled(DESIGN_RUN)
     tmp = given[0] if given else tmp_path_factory.mktemp("design")
-    return prefetch.result(DESIGN_RUN, solve_short_design, tmp), tmp / "out"
+    status, checked = prefetch.result(DESIGN_RUN, solve_short_design, tmp)
+    return status, tmp / "out", checked
 
 
 def test_design_report_has_every_section_and_matches_result(design_run):
-    status, out = design_run
+    status, out, checked = design_run
     r, result = read(out), json.loads((out / "result.json").read_text())
-    checked = result["status"] in ("verified", "failed verification")   # an optimum to check
+    check_ran = result["status"] in ("verified", "failed verification")  # an optimum to check
     assert r.sections == ["problem", "verification", *GRASP_SECTIONS,
-                          *(["model-check"] if checked else []), "convergence", "reproduce"]
+                          *(["model-check"] if check_ran else []), "convergence", "reproduce"]
     assert list(r.figures) == GRASP_FIGURES + ["fig-convergence"]
     passed = result["verification"]["passed"]
     assert (status == 0) == passed
@@ -200,23 +236,31 @@ def test_design_report_has_every_section_and_matches_result(design_run):
     optimiser = r.column("verification-table", "optimiser or limit")
     assert close(optimiser[0], v["optimiser_hold_time_s"]) and close(optimiser[1], v["cap_N"])
     assert len(r.tables["history-table"]) - 1 == len(result["solver"]["history"])
-    # the spatial model check: both designs' runs in the table, the cap's rule
-    # (the baseline's peak) resolved on the spatial baseline
-    check = result["model_check"] if checked else None
-    if check:
+    # the spatial model check: handed the baseline at the start and the
+    # reported optimum; both runs in the report's table, the cap's rule (the
+    # baseline's peak) resolved on the spatial baseline
+    variables = result["variables"]
+    scaled = [(v["baseline"] - v["lower"]) / (v["upper"] - v["lower"]) for v in variables]
+    assert checked[0] == ("baseline", pytest.approx(scaled))
+    if check_ran:
+        optimum = [(v["optimum"] - v["lower"]) / (v["upper"] - v["lower"]) for v in variables]
+        assert checked[1] == (result["case"], pytest.approx(optimum, abs=1e-12))
+        check = result["model_check"]
         bird = check["birds"][0]
         holds = r.column("model-check-table", "hold (s)")
         assert close(holds[0], bird["baseline"]["hold_time_s"])
         assert close(holds[1], bird["optimum"]["hold_time_s"])
         assert bird["cap_N"] == bird["baseline"]["max_finger_force_N"]
-        assert check["finger_model"] == "spatial" and bird["optimum"]["ok"]
+        assert check["gain_survives"] and "the gain survives" in r.banner
+    else:
+        assert result["model_check"] is None and len(checked) == 1
 
 
 def test_design_report_draws_the_pareto_curve(design_run, tmp_path):
     """With a Pareto study the report adds its table and curve (the study's
     rows here are made up; the page only draws them; the runs drawn are the
     short grasp's, the design run's own baseline)."""
-    _, out = design_run
+    _, out, _ = design_run
     result = json.loads((out / "result.json").read_text())
     result["pareto"] = [{"cap_N": c, "status": "verified", "optimiser_hold_time_s": h,
                          "verified_hold_time_s": h, "verified_max_finger_force_N": c - 1,
