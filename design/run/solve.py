@@ -31,7 +31,7 @@ from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.model_check import ModelCheck, check_text
+from design.solve.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, SETUP, STUDY,
                                            VERIFICATION, Profile, clocks)
 from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
@@ -194,8 +194,6 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
 NO_DESIGN = "no design (optimiser error)"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
-#: the model check's label for the baseline design
-BASELINE = "baseline"
 #: the profiles and fine simulations of the cases this process ran (the
 #: engine returns JSON; the report needs the simulations themselves)
 _PROFILES: dict[str, Profile] = {}

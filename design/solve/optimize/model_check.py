@@ -43,6 +43,8 @@ from design.solve.optimize.trust_region import CAP_TOLERANCE
 
 #: the model the check runs and the one it checks
 CHECK_MODEL, DESIGN_MODEL = "spatial", "planar"
+#: the label of the baseline design's runs
+BASELINE = "baseline"
 
 
 def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
@@ -145,7 +147,7 @@ class ModelCheck:
                                    f"{run['message']}")
         return runs
 
-    def result(self, population, cap_spec, baseline: str = "baseline",
+    def result(self, population, cap_spec, baseline: str = BASELINE,
                optimum: str = "optimum") -> dict:
         """:func:`compare` of the runs submitted as ``baseline`` and ``optimum``."""
         return compare(population, cap_spec, self.summaries(baseline), self.summaries(optimum),
