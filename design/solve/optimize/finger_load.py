@@ -14,7 +14,7 @@ bending both ways against the ellipsoid with regularised Coulomb friction
 against the finger's sliding (a smooth function of the bird's state and
 time, so that it needs no friction sense from the schedule).
 
-Inputs (:attr:`StageModel.sizes`): planar, the bird pose (X, Z, θ) (m, rad)
+Inputs (each stage model's ``sizes``): planar, the bird pose (X, Z, θ) (m, rad)
 and the signed friction τµ; spatial, the bird's whole state (X, Z, θ and
 their rates; the rates set the sliding); both, the time t (s), the
 finger's design fp = (angle, height, drum radius, φx, φy, length) (rad,
