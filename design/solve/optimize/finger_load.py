@@ -58,6 +58,8 @@ C code compiled once and cached on disk; interpreted when no compiler).
 
 from __future__ import annotations
 
+import os
+
 import casadi as ca
 import numpy as np
 
@@ -98,6 +100,8 @@ class PlanarStage:
     n_fixed = 6
     #: the implicit-function adjoint's linear solver (the residual Jacobian's sparsity)
     solver = "qr"
+    #: its stages are cheap (0.05 ms): serial
+    threads = 1
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
                  intervals: int, degree: int):
@@ -147,6 +151,10 @@ class SpatialStage:
     n_fixed = 8
     #: dense LU, as the spatial rootfinder's (spatial_equations.py: 39 % full)
     solver = "lapacklu"
+    #: the stages' contacts and Jacobian blocks over this many threads (at most the
+    #: cores): hold_time_spatial.yaml 487.7 -> 385.6 s back to back on 2 cores,
+    #: nlp_g 229 -> 157 s, every iterate the same
+    threads = 2
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
                  intervals: int, degree: int):
@@ -297,6 +305,13 @@ class FingerLoad:
                             "enable_reverse": False,
                             "is_diff_out": DIFFERENTIABLE})
 
+    def _mapped(self, f: ca.Function, n: int) -> ca.Function:
+        """f over n stages: serial, or over the machine's cores for a model
+        whose stages are worth it (``threads``): every column is the same
+        computation either way, so the results are identical."""
+        threads = min(self.model.threads, os.cpu_count() or 1)
+        return f.map(n, "thread", threads) if threads > 1 and n > 1 else f.map(n)
+
     @property
     def stage_solves(self) -> int:
         """Contacts solved so far by this finger's batches (stages x solves;
@@ -314,7 +329,7 @@ class FingerLoad:
             name = f"{f.name()}_x{n}"
             ins = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
             outs = [ca.MX.sym(f"out_{o}", f.size1_out(k), n) for k, o in enumerate(OUTPUTS)]
-            blocks = jac.map(n)(*ins, *outs)
+            blocks = self._mapped(jac, n)(*ins, *outs)
             # the stage blocks side by side hold the block-diagonal matrix's
             # nonzeros in its own (column-major) order: a cast, no copy
             diagonal = [ca.sparsity_cast(b, ca.diagcat(*[jac.sparsity_out(k)] * n))
@@ -326,7 +341,7 @@ class FingerLoad:
             st, c = self._stages[mode], ca.DM(self.constants)
             ins_f = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
             x = ca.vertcat(*ins_f[:len(self.sizes)])
-            roots = _Roots(f"{name}_roots", st.rootfinder.map(n), st.tr.n_q)
+            roots = _Roots(f"{name}_roots", self._mapped(st.rootfinder, n), st.tr.n_q)
             z = roots(ins_f[-1], st.pre.map(n)(x, c))
             load, force = st.loads.map(n)(x, z, c)
             self._batches[key] = (ca.Function(
