@@ -34,11 +34,7 @@ def beam_figure(table_2_1: dict, table_2_3: dict) -> Figure:
                    label="non-uniform soft finger" if name == "collocation" else name)
     right.set_title("Table 2-3: non-uniform finger, 15 N at 76.2 mm")
     for ax in (left, right):
-        ax.set_xlabel("x_f (mm)")
-        ax.set_ylabel("y_f (mm)")
-        ax.set_aspect("equal")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
+        _drawn_to_scale(ax, "x_f (mm)", "y_f (mm)", 8)
     return fig
 
 
@@ -146,9 +142,14 @@ def transverse_figure(graspers: dict, birds: dict, families: tuple[str, ...] = (
             ax.plot([y0 * MM, y1 * MM], [z0 * MM, z1 * MM], "k" + style, lw=1.4,
                     label=f"fingers {', '.join(families)}, {label}" if k == 0 else None)
     ax.axhline(0.0, color="0.5", lw=0.8)
-    ax.set_xlabel("Y (mm, the right drum's side)")
-    ax.set_ylabel("Z above the belt (mm)")
+    _drawn_to_scale(ax, "Y (mm, the right drum's side)", "Z above the belt (mm)", 7)
+    return fig
+
+
+def _drawn_to_scale(ax, xlabel: str, ylabel: str, legend_size: int) -> None:
+    """Labels, equal scales on both axes (shapes and sections), grid, legend."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.set_aspect("equal")
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7)
-    return fig
+    ax.legend(fontsize=legend_size)
