@@ -106,21 +106,20 @@ def test_support_derivatives():
 
 
 @pytest.mark.parametrize("tilt", [0.0, 0.3])
-def test_a_point_carried_by_the_drum_follows_its_finger_frames(tilt):
-    """The reach filter turns a finger's base and axis at t = 0 about the
-    drum's (tilted) axis for all times at once: the same as the finger frame
-    evaluated at each time (1e-12 m)."""
-    from design.solve.grasp.fingers import carried_by_drum
-
+def test_the_drums_turning_carries_a_finger_frame_in_time(tilt):
+    """The simulator and the reach filter turn a finger's frame at t = 0 about
+    the drum's (tilted) axis (Drum.turning, for one time and for all at once):
+    the same as the finger frame evaluated at each time (1e-12 m, 1e-12)."""
     drum = Drum(0.368, 20 * 2 * np.pi / 60, x=0.01, tilt=tilt)
     mount = FingerMount(angle=1.9, height=0.03, radius=0.108, phi_x=0.7, phi_y=0.26)
     times = np.linspace(0.0, 2.0, 41)
     base0, R0 = drum.frame(mount, 0.0)
-    base, axis = carried_by_drum(drum, times, base0, R0[:, 0])
+    turns = drum.turning(times)
     for k, t in enumerate(times):
         b, R = drum.frame(mount, t)
-        np.testing.assert_allclose(base[k], b, atol=1e-12)
-        np.testing.assert_allclose(axis[k], R[:, 0], atol=1e-12)
+        np.testing.assert_array_equal(drum.turning(t), turns[k])
+        np.testing.assert_allclose(drum.origin + turns[k] @ (base0 - drum.origin), b, atol=1e-12)
+        np.testing.assert_allclose(turns[k] @ R0, R, atol=1e-12)
 
 
 def test_the_straight_fingers_least_level_is_the_sampled_minimum():

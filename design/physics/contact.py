@@ -127,11 +127,16 @@ def no_contact(pose: FingerPose, length: float, message: str, converged: bool = 
 def segment_overlap(ellipse: Ellipse, length: float) -> float:
     """min over the undeflected finger (0 ≤ x ≤ l, y = 0) of the level function;
     < 0 when the straight finger would pass through the object."""
-    B, c = ellipse.matrix, np.asarray(ellipse.center)
-    # f(x, 0) = B00 (x - cx)^2 - 2 B01 (x - cx) cy + B11 cy^2 - 1: a parabola in x
-    x_star = c[0] + B[0, 1] * c[1] / B[0, 0]
-    xs = np.array([0.0, length, np.clip(x_star, 0.0, length)])
-    return float(np.min(ellipse.level(xs, np.zeros(3))))
+    return straight_overlap(np.asarray(ellipse.center), ellipse.matrix, length)
+
+
+def straight_overlap(center: np.ndarray, B: np.ndarray, length: float) -> float:
+    """:func:`segment_overlap` of the conic (u - c)ᵀ B (u - c) = 1."""
+    # f(x, 0) = B00 (x - cx)^2 + 2 B01 (x - cx) (-cy) + B11 cy^2 - 1: a parabola in x
+    x_star = center[0] + B[0, 1] * center[1] / B[0, 0]
+    dx = np.array([0.0, length, np.clip(x_star, 0.0, length)]) - center[0]
+    dy = -center[1]
+    return float(np.min(B[0, 0] * dx * dx + 2 * B[0, 1] * dx * dy + B[1, 1] * dy * dy) - 1.0)
 
 
 def grazing(ellipse: Ellipse, length: float, side: int) -> tuple[float, float] | None:

@@ -37,6 +37,16 @@ class Ellipse:
     center: tuple[float, float]
     theta: float = 0.0
 
+    @staticmethod
+    def from_conic(center, B) -> "Ellipse":
+        """The ellipse (u - c)ᵀ B (u - c) = 1 (B positive definite): semi-axes
+        1/sqrt of B's eigenvalues, the larger first; θ from the first's
+        eigenvector."""
+        vals, vecs = np.linalg.eigh(B)
+        axes = 1.0 / np.sqrt(vals)
+        theta = float(np.arctan2(vecs[1, 0], vecs[0, 0]))
+        return Ellipse(float(axes[0]), float(axes[1]), (float(center[0]), float(center[1])), theta)
+
     @property
     def params(self) -> np.ndarray:
         """[cx, cy, theta, a, b], the order :func:`level_casadi` expects."""

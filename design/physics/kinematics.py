@@ -132,6 +132,20 @@ class Drum:
     def origin(self) -> np.ndarray:
         return np.array([self.x, -self.spacing / 2, 0.0])
 
+    def turning(self, t) -> np.ndarray:
+        """The rotation carrying drum-fixed vectors from t = 0 to t (s): -ω t
+        about the drum's (tilted) axis; (3, 3), or (n, 3, 3) for n times.
+        A finger's frame at t is (origin + M (base₀ - origin), M R₀)."""
+        t = np.asarray(t, float)
+        c, s = np.cos(self.speed * t), np.sin(self.speed * t)
+        turn = np.zeros(t.shape + (3, 3))
+        turn[..., 0, 0], turn[..., 0, 1], turn[..., 1, 0], turn[..., 1, 1] = c, s, -s, c
+        turn[..., 2, 2] = 1.0
+        if self.tilt == 0.0:
+            return turn
+        tilt = rot_y(self.tilt)
+        return tilt @ turn @ tilt.T
+
     def frame(self, mount: FingerMount, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Base point (3,) and rotation (3, 3) of a finger at time t (right drum)."""
         return finger_frame(mount.angle, mount.height, mount.radius, mount.phi_x, mount.phi_y,
@@ -177,18 +191,18 @@ class Ellipsoid:
                       points - np.asarray(self.center).reshape(3, *([1] * (points.ndim - 1))))
         return np.einsum("i...,ii,i...->...", p, self.matrix, p) - 1.0
 
+    def section(self, base: np.ndarray, R: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """The plane z_f = 0 of a finger frame cutting the ellipsoid, as a conic
+        in that frame's (x_f, y_f): (centre, matrix, rhs), see :func:`section`."""
+        return section((self.eta, self.lam, self.gamma), self.center, self.pitch,
+                       np.asarray(base, float), R)
+
     def cut(self, base: np.ndarray, R: np.ndarray) -> Ellipse | None:
         """The ellipse in which the plane z_f = 0 of a finger frame cuts the
         ellipsoid, in that frame's (x_f, y_f) coordinates; None if it misses
         (see :func:`section`)."""
-        u0, B, rhs = section((self.eta, self.lam, self.gamma), self.center, self.pitch,
-                             np.asarray(base, float), R)
-        if rhs <= 0.0:
-            return None
-        vals, vecs = np.linalg.eigh(B)
-        axes = 1.0 / np.sqrt(vals)
-        theta = float(np.arctan2(vecs[1, 0], vecs[0, 0]))
-        return Ellipse(float(axes[0]), float(axes[1]), (float(u0[0]), float(u0[1])), theta)
+        u0, B, rhs = self.section(base, R)
+        return Ellipse.from_conic(u0, B) if rhs > 0.0 else None
 
     def lowest_point(self) -> tuple[float, float]:
         """(X offset ahead of the centre, depth D below it) of the lowest point

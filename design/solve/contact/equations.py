@@ -107,9 +107,13 @@ class ContactTranscription:
         self.shape = ca.Function(f"contact_{mode}_shape", [z, q], beam.shape(w, P))
         # implicit-function sensitivities: dR/dz, dR/d(cx, cy, θ, a, b), d(x_L, y_L, L)/dz
         tip_l = ca.vertcat(x, y, L)
+        # (dense, for design.solve.buffers: reading a 63 x 63 DM into numpy took
+        # longer than evaluating it)
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
-            [ca.jacobian(R, z), ca.jacobian(R, q[ELLIPSE]), ca.jacobian(tip_l, z)])
+            [ca.densify(ca.jacobian(R, z)), ca.densify(ca.jacobian(R, q[ELLIPSE])),
+             ca.densify(ca.jacobian(tip_l, z))])
+        self._continued: dict = {}
         self._newton = NewtonCache(
             f"contact_{self.mode}_newton", self.residual, "qr",
             lambda: compiled_jacobian(self.residual,
@@ -121,6 +125,17 @@ class ContactTranscription:
         """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton),
         its Jacobian compiled (a few seconds once, on an empty cache)."""
         return self._newton.get(tolerance, max_iter, error_on_fail, compiled_jacobian)
+
+    def continued(self, tolerance: float, max_iter: int) -> ca.Function:
+        """(z0, q) -> (z, post, max |R|): :meth:`rootfinder` and :attr:`post` in
+        one call, for an integrator's many trial solves (cached)."""
+        key = (tolerance, max_iter)
+        if key not in self._continued:
+            z0, q = ca.MX.sym("z0", self.n_z), ca.MX.sym("q", self.n_q)
+            z = self.rootfinder(tolerance, max_iter)(z0, q)
+            self._continued[key] = ca.Function(
+                f"contact_{self.mode}_{self.ellipse}_continued", [z0, q], [z, *self.post(z, q)])
+        return self._continued[key]
 
     def parameters(self, length: float, ei_ref: float, ellipse: Ellipse, tau_mu: float,
                    widths: np.ndarray, stiffness: Stiffness) -> np.ndarray:

@@ -39,17 +39,21 @@ makes the sliding velocity zero is found by bisection.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
 
 from design.physics.beam import Finger, PointLoad, straight_solution
 from design.physics.contact import (SIDES, ContactSolution, FingerPose, Motion, grazing,
-                                    no_contact, segment_overlap, swept_grazing, turned)
+                                    no_contact, segment_overlap, straight_overlap,
+                                    swept_grazing, turned)
 from design.physics.ellipse import Ellipse, rotation
 from design.solve.beam.collocation import adapted_widths
 from design.solve.contact.equations import MODES, contact_transcription
+from design.solve.buffers import evaluate
+from design.solve.newton import implicit_rate
 
 #: |penetration| below this (m) is rounding, not a second contact
 PENETRATION_TOL = 1e-9
@@ -104,14 +108,21 @@ def follow(state, step: Callable, clear: Callable[[], bool], max_steps: int):
 
 @dataclass
 class _State:
-    """A solved contact: mode, unknowns, and the parameters they solve."""
+    """A solved contact: mode, unknowns, and the parameters they solve: the
+    ``ellipse``, or for a trial (:meth:`RobustContact.continue_trial`) its
+    ``conic`` (centre, B), made an ellipse when the state is continued."""
 
     mode: str
     z: np.ndarray
-    ellipse: Ellipse
+    ellipse: Ellipse | None
     tau_mu: float
     side: int
     post: np.ndarray | None = None
+    conic: tuple[np.ndarray, np.ndarray] | None = None
+
+    def with_ellipse(self) -> "_State":
+        return self if self.ellipse is not None else \
+            replace(self, ellipse=Ellipse.from_conic(*self.conic))
 
 
 class RobustContact:
@@ -230,6 +241,7 @@ class RobustContact:
         """
         self.newton_iterations = 0
         length = self.finger.length
+        previous = previous and previous.with_ellipse()
         if ell.level(0.0, 0.0) <= 0.0:
             return no_contact(pose, length, "the finger base is inside the object: invalid pose",
                               converged=False), None
@@ -273,6 +285,38 @@ class RobustContact:
                 if again.penetration == 0.0:
                     return again, fresh
         return sol, state
+
+    @cached_property
+    def _conic(self) -> dict:
+        """The contact equations with the ellipse as a conic (centre, B): what
+        a section gives without an eigen-decomposition."""
+        return {m: contact_transcription(self.finger.stiffness, self.intervals, self.degree, m,
+                                         "conic") for m in MODES}
+
+    def continue_trial(self, previous: _State, center: np.ndarray, B: np.ndarray):
+        """An integrator's trial evaluation: the contact at a new section of the
+        object, the conic (u - c)ᵀ B (u - c) = 1 in the finger frame, by one
+        Newton solve from ``previous`` (mode, side and friction kept) in one
+        compiled call. Returns (solution, state), or None where that is not
+        the whole answer (the finger's base inside the object or its straight
+        line clear of it, Newton not converged to the tolerance within
+        MAX_STEP_ITERATIONS, a mode switch, a release, the finger bent to the
+        other side, F < 0): :meth:`solve_frame` then continues in steps."""
+        length, mode = self.finger.length, previous.mode
+        if center @ B @ center <= 1.0 or straight_overlap(center, B, length) >= 0.0:
+            return None
+        q = np.concatenate([[length, self.ei_ref, center[0], center[1], B[0, 0], B[0, 1],
+                             B[1, 1], previous.tau_mu], self.widths,
+                            self.finger.stiffness.params])
+        solve = self._conic[mode].continued(self.tolerance, MAX_STEP_ITERATIONS)
+        z, post, resid = (np.asarray(v).ravel() for v in solve(previous.z, q))
+        if not resid[0] <= self.tolerance or post[3] < 0 or previous.side * post[11] <= 0 \
+                or self._check(mode, post) != "ok":
+            return None
+        state = _State(mode, z, None, previous.tau_mu, previous.side, post, (center, B))
+        self.newton_iterations = 0
+        return self._brief(state, FingerPose(0.0, 0.0), self._friction_label(state.tau_mu), "",
+                           True), state
 
     def _settled(self, state: _State, msg: str, pose: FingerPose, kinematics, settling: bool,
                  detail: bool) -> tuple[ContactSolution, _State | None]:
@@ -538,11 +582,11 @@ class RobustContact:
         tr = self.tr[state.mode]
         q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
                           self.widths, self.finger.stiffness)
-        jz, jq, jtip = (np.asarray(m) for m in tr.sensitivity(state.z, q))
+        jz, jq, jtip = evaluate(tr.sensitivity, state.z, q)
         post, _ = (np.asarray(v).ravel() for v in tr.post(state.z, q))
         point = post[:2]
         q_dot, v_object = kin(point)
-        z_dot = np.linalg.lstsq(jz, -jq @ q_dot, rcond=None)[0]
+        z_dot = implicit_rate(jz, -jq @ q_dot)
         x_dot, y_dot, l_dot = jtip @ z_dot
         t_f = np.array([np.cos(post[2]), np.sin(post[2])])
         v_material = np.array([x_dot, y_dot]) - t_f * l_dot

@@ -35,6 +35,8 @@ from design.physics.beam import PointLoad, straight_solution
 from design.solve.beam.rod import RodStiffness
 from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, PENETRATION_TOL, follow
 from design.solve.contact.spatial_equations import MODES, spatial_transcription
+from design.solve.buffers import evaluate
+from design.solve.newton import implicit_rate
 
 #: the straight finger enters the object over less than grazing_shift's grid
 #: resolves (l / 200): a touch without force, not a failure
@@ -296,10 +298,10 @@ class SpatialContact:
         """
         tr = self.tr[state.mode]
         q = self._params(state.quadric, state.friction)
-        jz, jq, jtip = (np.asarray(m) for m in tr.sensitivity(state.z, q))
+        jz, jq, jtip = evaluate(tr.sensitivity, state.z, q)
         post = state.post
         q_dot, v_object = kin(post[:3])
-        z_dot = np.linalg.lstsq(jz, -jq @ q_dot, rcond=None)[0]
+        z_dot = implicit_rate(jz, -jq @ q_dot)
         rl_dot = jtip @ z_dot
         d1 = post[13:16]
         v = rl_dot[:3] - d1 * rl_dot[3] - v_object

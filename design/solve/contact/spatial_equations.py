@@ -113,10 +113,12 @@ class SpatialContactTranscription:
             [ca.vertcat(r, nu * ei_r / length ** 2, L, level, along, normal, force, d1, t_p),
              ca.mmax(ca.fabs(R))])
         self.shape = ca.Function(f"spatial_{mode}_shape", [z, q], rod.shape(w, P))
-        # implicit-function sensitivities: dR/dz, dR/d(c, Q), d(r, L)/dz
+        # implicit-function sensitivities: dR/dz, dR/d(c, Q), d(r, L)/dz (dense,
+        # for design.solve.buffers)
         self.sensitivity = ca.Function(
             f"spatial_{mode}_sens", [z, q],
-            [ca.jacobian(R, z), ca.jacobian(R, q[QUADRIC]), ca.jacobian(ca.vertcat(r, L), z)])
+            [ca.densify(m) for m in (ca.jacobian(R, z), ca.jacobian(R, q[QUADRIC]),
+                                     ca.jacobian(ca.vertcat(r, L), z))])
         # dense LU: the load's direction follows the normal at r(L), which
         # depends on every node's quaternion, so the Jacobian is 39 % full
         # (17 635 of 212² entries, 6 intervals of degree 4); LAPACK's LU

@@ -36,7 +36,7 @@ from design.physics.bird import Bird, Loads
 from design.physics.contact import ContactSolution
 from design.physics.ellipse import Ellipse
 from design.physics.grasper import Grasper
-from design.physics.kinematics import Ellipsoid, rot_y
+from design.physics.kinematics import Ellipsoid
 from design.solve.contact import RobustContact
 from design.solve.contact.spatial import (FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, segment_level)
@@ -99,30 +99,17 @@ def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end
     lo = np.stack([centres[:, 0] - margin, np.zeros(times.size), np.zeros(times.size)], axis=1)
     hi = np.stack([centres[:, 0] + margin, np.zeros(times.size), centres[:, 1] + margin], axis=1)
     s = np.linspace(0.0, 1.0, 24)[None, :, None]
+    turns = drum.turning(times)
     out = []
     for gf in grasper.fingers:
         base0, R0 = drum.frame(gf.mount, 0.0)
-        base, axis = carried_by_drum(drum, times, base0, R0[:, 0])
+        base = drum.origin + turns @ (base0 - drum.origin)
+        axis = turns @ R0[:, 0]
         pts = base[:, None, :] + s * gf.finger.length * axis[:, None, :]   # (n, 24, 3)
         gap = np.maximum(np.maximum(lo[:, None, :] - pts, 0.0), pts - hi[:, None, :])
         near = np.min(np.linalg.norm(gap, axis=2), axis=1) <= reach
         out.append(_windows(near, times, dt))
     return out
-
-
-def carried_by_drum(drum, times: np.ndarray, point: np.ndarray, direction: np.ndarray
-             ) -> tuple[np.ndarray, np.ndarray]:
-    """A point and a direction fixed to the drum at t = 0, at ``times`` (n,):
-    the drum turns by -ω t about its own (tilted) axis. Returns (n, 3) each."""
-    c, s = np.cos(drum.speed * times), np.sin(drum.speed * times)
-    tilt = rot_y(drum.tilt)
-
-    def turned(v: np.ndarray) -> np.ndarray:
-        v = tilt.T @ v
-        return np.stack([c * v[0] + s * v[1], -s * v[0] + c * v[1],
-                         np.full(times.size, v[2])], axis=1) @ tilt.T
-
-    return drum.origin + turned(point - drum.origin), turned(direction)
 
 
 def _windows(near: np.ndarray, times: np.ndarray, dt: float) -> list[tuple[float, float]]:
@@ -166,7 +153,14 @@ class PlanarFinger:
 
     def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
         """(force on the bird (3,) world, contact point (3,) world, solution,
-        state to continue from); force None when the plane misses the bird."""
+        state to continue from); force None when the plane misses the bird.
+        A trial evaluation continued from a contact is first tried in one
+        Newton solve (:meth:`RobustContact.continue_trial`)."""
+        if not commit and start is not None:
+            center, B, rhs = body.section(base, R)
+            trial = self.solver.continue_trial(start, center, B) if rhs > 0.0 else None
+            if trial is not None:
+                return self._world(base, R, *trial)
         cut = body.cut(base, R)
         if cut is None:
             return None, None, None, None
@@ -182,6 +176,10 @@ class PlanarFinger:
 
         sol, cont = self.solver.solve_frame(cut, "auto", kin, start, settle=commit,
                                             detail=commit)
+        return self._world(base, R, sol, cont)
+
+    @staticmethod
+    def _world(base, R, sol, cont):
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         f_w = R[:, :2] @ sol.force_on_object_finger_frame
@@ -237,17 +235,17 @@ class SpatialFinger:
 FINGER_MODELS = {"planar": PlanarFinger, "spatial": SpatialFinger}
 
 
-def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length: float) -> float:
+def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
     """min over the straight finger (base + x axis, 0 ≤ x ≤ length) of the
     bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
-    1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird."""
-    Rb = body.rotation
+    1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
+    For n fingers at once: base and axis (n, 3), length (n,); returns (n,)."""
     scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
-    p = scale * (Rb.T @ (base - np.asarray(body.center)))
-    e = scale * (Rb.T @ axis)
-    x = min(max(-float(p @ e) / float(e @ e), 0.0), length)
-    q = p + x * e
-    return float(q @ q) - 1.0
+    p = scale * ((base - np.asarray(body.center)) @ body.rotation)
+    e = scale * (axis @ body.rotation)
+    x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
+    q = p + x[..., None] * e
+    return np.sum(q * q, axis=-1) - 1.0
 
 
 def body_quadric(body: Ellipsoid, base: np.ndarray, R: np.ndarray) -> Quadric:
@@ -281,26 +279,53 @@ class FingerForces:
         self.skipped = 0           # finger evaluations the reach windows saved
         self._memo: dict = {}      # trial evaluations since the last commit
         self._frames: dict = {}    # (finger, t) -> its frame, for the latest times
+        self._turns: dict = {}     # t -> the drum's turning since t = 0
+        self._start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
+        self._lengths = np.array([gf.finger.length for gf in grasper.fingers])
+        # every window's start, end and finger, for a vectorised test
+        spans = [(a, b, i) for i, w in enumerate(windows or []) for a, b in w]
+        self._window_ends = None if windows is None else (
+            np.array([a for a, _, _ in spans], float), np.array([b for _, b, _ in spans], float),
+            np.array([i for _, _, i in spans], int))
 
     def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Finger i's (base, R) at time t. An evaluation asks for the same
-        frames several times (contact, rates at t + RATE_STEP, shares); the
-        arrays are shared, hence read-only."""
+        """Finger i's (base, R) at time t: its frame at t = 0 turned with the
+        drum. An evaluation asks for the same frames several times (contact,
+        rates at t + RATE_STEP, shares); the arrays are shared, hence
+        read-only."""
         key = (i, t)
         out = self._frames.get(key)
         if out is None:
             if len(self._frames) > 64 * len(self.models):
                 self._frames.clear()
-            out = self.drum.frame(self.grasper.fingers[i].mount, t)
+                self._turns.clear()
+            turn = self._turns.get(t)
+            if turn is None:
+                turn = self._turns[t] = self.drum.turning(t)
+            base0, R0 = self._start[i]
+            origin = self.drum.origin
+            out = (origin + turn @ (base0 - origin), turn @ R0)
             for a in out:
                 a.setflags(write=False)
             self._frames[key] = out
         return out
 
-    def active(self, i: int, t: float) -> bool:
-        if self.windows is None:
-            return True
-        return any(a <= t <= b for a, b in self.windows[i])
+    def reaching(self, t: float, body: Ellipsoid) -> set[int]:
+        """The fingers whose straight line enters the bird at time t (level ≤
+        MISSES), among those inside their reach windows (the others count as
+        skipped)."""
+        if self._window_ends is None:
+            inside = np.arange(len(self.models))
+        else:
+            lo, hi, owner = self._window_ends
+            inside = np.unique(owner[(lo <= t) & (t <= hi)])
+        self.skipped += len(self.models) - inside.size
+        if inside.size == 0:
+            return set()
+        frames = [self.frame(i, t) for i in inside]
+        level = straight_level(body, np.array([b for b, _ in frames]),
+                               np.array([R[:, 0] for _, R in frames]), self._lengths[inside])
+        return set(inside[level <= MISSES].tolist())
 
     def ellipsoid(self, y: np.ndarray) -> Ellipsoid:
         b = self.bird
@@ -323,11 +348,11 @@ class FingerForces:
         body = self.ellipsoid(y)
         loads, states = Loads(), []
         centre = np.array([y[0], 0.0, y[1]])
+        reaching = self.reaching(t, body)
         for i, gf in enumerate(self.grasper.fingers):
             force = None
-            base, R = self.frame(i, t) if self.active(i, t) else (None, None)
-            if base is not None and \
-                    straight_level(body, base, R[:, 0], gf.finger.length) <= MISSES:
+            if i in reaching:
+                base, R = self.frame(i, t)
                 # continue from the latest solution, trial or committed: the nearest
                 # in time (trials keep the committed friction); or, for a model whose
                 # friction is solved with the contact (spatial), always from the
@@ -337,8 +362,6 @@ class FingerForces:
                 force, p_w, sol, cont = model.solve(
                     body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
                     commit)
-            elif base is None:
-                self.skipped += 1
             if force is None:                       # out of reach: no contact problem
                 self.trials[i] = None
                 if commit:
