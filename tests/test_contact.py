@@ -352,3 +352,47 @@ def test_failed_friction_reversal_is_not_converged(monkeypatch):
     sol, _ = solver.solve_frame(ell, "auto", kin, None)
     assert not sol.converged and "the friction could not reverse" in sol.message
     assert sol.friction == "tipward"
+
+
+def _conic(ell: Ellipse):
+    return np.asarray(ell.center, float), ell.matrix
+
+
+@pytest.mark.parametrize("shift", [2e-4, 2e-3])
+def test_a_trial_in_one_newton_solve_is_the_stepped_continuation(shift):
+    """An integrator's trial evaluation (RobustContact.continue_trial: one
+    Newton solve on the section as a conic, in one compiled call) gives the
+    contact the stepped continuation gives from the same state (solve_frame,
+    friction kept): force and angle to 1e-9 relative (both solve to a 1e-12
+    residual; the conic and the axes forms of the ellipse round differently)."""
+    pose, ell_w = CASE1
+    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4)
+    _, state = solver.solve_frame(ell, "push", None, None)
+    moved = ell.shifted(0.0, shift)
+    trial = solver.continue_trial(state, *_conic(moved))
+    assert trial is not None
+    stepped, _ = solver.solve_frame(moved, "auto", None, state, settle=False, detail=False)
+    assert stepped.converged and trial[0].converged
+    assert trial[0].force == pytest.approx(stepped.force, rel=1e-9)
+    assert trial[0].alpha == pytest.approx(stepped.alpha, rel=1e-9)
+    assert trial[0].force > state.post[3]            # pressed further in: more force
+    # the state it returns continues like any other: a commit from it
+    again, _ = solver.solve_frame(moved, "auto", None, trial[1])
+    assert again.force == pytest.approx(stepped.force, rel=1e-9)
+
+
+def test_a_trial_that_needs_more_than_one_newton_solve_is_left_to_the_steps():
+    """Where one Newton solve is not the whole answer, continue_trial returns
+    None and the caller takes the stepped path: the object moved clear of the
+    straight finger (a release), or so far that Newton from the old state does
+    not converge within MAX_STEP_ITERATIONS."""
+    pose, ell_w = CASE1
+    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4)
+    _, state = solver.solve_frame(ell, "push", None, None)
+    clear = ell.shifted(0.0, -0.15)
+    assert segment_overlap(clear, solver.finger.length) >= 0.0
+    assert solver.continue_trial(state, *_conic(clear)) is None
+    far = ell.shifted(-0.03, 0.01)                      # 6.3 N -> 74 N
+    assert solver.continue_trial(state, *_conic(far)) is None
+    sol, _ = solver.solve_frame(far, "auto", None, state, settle=False, detail=False)
+    assert sol.converged and sol.force > 10 * state.post[3]   # the steps get there
