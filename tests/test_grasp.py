@@ -39,12 +39,18 @@ def hard_fine():
 
 
 def test_default_integrator_is_within_target_of_a_4x_finer_run(hard, hard_fine):
-    """Issue 4's targets: hold time within 1%, peak finger force within 2%
-    (measured: 0.3% and 1.96%, the peak being finger 5a's beyond its fold)."""
+    """Issue 4's targets: hold time within 1%, peak finger force within 2%.
+    Measured: 0.04 % and 0.02 % (the peak being finger 5a's beyond its fold),
+    since the fingers' friction reversals are located as events; decided at
+    the accepted steps instead they came 0.35 % and 1.96 % off, hence the
+    0.2 % bounds."""
     a, b = hard.summary, hard_fine.summary
     assert a["hold_time_s"] > 0.15
     assert a["hold_time_s"] == pytest.approx(b["hold_time_s"], rel=0.01)
     assert a["max_finger_force_N"] == pytest.approx(b["max_finger_force_N"], rel=0.02)
+    assert a["hold_time_s"] == pytest.approx(b["hold_time_s"], rel=0.002)
+    assert a["max_finger_force_N"] == pytest.approx(b["max_finger_force_N"], rel=0.002)
+    assert any(name == "friction reverses" for _, name in hard.trajectory.events)
     assert a["max_finger_force_finger"] == b["max_finger_force_finger"]
     assert hard.trajectory.steps < hard_fine.trajectory.steps
 
@@ -53,8 +59,12 @@ def test_thesis_bdf4_with_frozen_forces_is_far_off(hard_fine):
     """The thesis's fixed-step BDF-4 with forces frozen over the step: at its
     5.6 ms step the peak force is 2.0x too high and the bird chatters on the
     belt (the hold splits into 5 windows against 2); at a quarter of the step
-    hold and peak are within 1% of the 4x finer adaptive run (measured:
-    0.2%, 0.5%)."""
+    it meets issue 4's targets against the 4x finer adaptive run (hold within
+    1 %, peak within 2 %), which makes it benchmarks/grasp.py's second
+    baseline. Measured: 0.39 %, 1.16 % (0.2 %, 0.5 % against the reference
+    before the adaptive run located its friction reversals as events; at an
+    eighth of the step the peak is 4.2 % off: frozen forces do not converge
+    steadily)."""
     s = thesis_grasp_setup(SKIP, DURATION, "hard")
     coarse = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=5.6e-3)).summary
     fine = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=1.4e-3)).summary
@@ -62,7 +72,7 @@ def test_thesis_bdf4_with_frozen_forces_is_far_off(hard_fine):
     assert coarse["max_finger_force_N"] > 1.5 * ref["max_finger_force_N"]
     assert len(coarse["hold_windows"]) > len(ref["hold_windows"]) + 2
     assert fine["hold_time_s"] == pytest.approx(ref["hold_time_s"], rel=0.01)
-    assert fine["max_finger_force_N"] == pytest.approx(ref["max_finger_force_N"], rel=0.01)
+    assert fine["max_finger_force_N"] == pytest.approx(ref["max_finger_force_N"], rel=0.02)
 
 
 def test_reach_filter_changes_nothing_but_the_work(hard):

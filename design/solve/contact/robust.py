@@ -513,7 +513,7 @@ class RobustContact:
         """
         v = self._sliding_velocity(state, kin)
         if self.reversal_speed is not None:
-            if v * state.tau_mu <= self.reversal_speed * self.mu:   # not clearly reversed
+            if self._margin(v, state.tau_mu) >= 0.0:             # not clearly reversed
                 return state, self._friction_label(state.tau_mu), "", v, True
             moved, msg = self._refriction(state, -state.tau_mu)
             if moved is None:
@@ -552,6 +552,17 @@ class RobustContact:
                                 f"the finger still slides at {v_a:+.3g} m/s ({why})", v_a, False)
         return (a, "stick", f"sticking contact: friction ratio {a.tau_mu:+.4f} (µ = {self.mu:g})",
                 v_a, True)
+
+    def reversal_margin(self, state: _State, kin: "Kinematics") -> float:
+        """With the friction kept at the edge of sliding (``reversal_speed``
+        set): how far the contact ``state`` is from having its friction
+        reversed, reversal_speed µ - v τµ (m/s times µ; v the sliding
+        velocity). Below zero the finger slides against its friction faster
+        than the reversal speed, and the next settled solve reverses it."""
+        return self._margin(self._sliding_velocity(state.with_ellipse(), kin), state.tau_mu)
+
+    def _margin(self, v: float, tau_mu: float) -> float:
+        return self.reversal_speed * self.mu - v * tau_mu
 
     def _refriction(self, state: _State, tau_mu: float):
         """``state`` with its friction ratio continued to ``tau_mu``; where that

@@ -56,6 +56,8 @@ FRICTION_SPEED = 0.02
 #: finger model decides by its own test (the planar one from its section,
 #: whose level differs from the ellipsoid's by rounding)
 MISSES = 1e-9
+#: the friction-reversal margin (m/s) reported where no finger's friction can reverse
+NO_REVERSAL = 1.0
 
 
 @dataclass
@@ -74,6 +76,8 @@ class FingerState:
     solution: ContactSolution | SpatialSolution | None = None
     normal_out_of_plane: float = 0.0
     sweep_out_of_plane: float = 0.0
+    #: the contact solver's state, to continue or test from
+    continued: object = None
 
     @property
     def magnitude(self) -> float:
@@ -150,6 +154,12 @@ class PlanarFinger:
                  reversal_speed: float = REVERSAL_SPEED):
         self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
                                     reversal_speed=reversal_speed)
+        self.reverses = friction > 0
+
+    def reversal_margin(self, state, kin_factory) -> float:
+        """:meth:`RobustContact.reversal_margin` of a contact state (m/s)."""
+        state = state.with_ellipse()
+        return self.solver.reversal_margin(state, kin_factory(state.ellipse))
 
     def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
         """(force on the bird (3,) world, contact point (3,) world, solution,
@@ -208,6 +218,8 @@ class SpatialFinger:
 
     name = "spatial"
     from_committed = True
+    #: friction solved with the contact, regularised: nothing to reverse
+    reverses = False
 
     def __init__(self, finger, friction: float, intervals: int, degree: int):
         self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
@@ -278,6 +290,7 @@ class FingerForces:
         self.solves = 0            # contact problems solved
         self.skipped = 0           # finger evaluations the reach windows saved
         self._memo: dict = {}      # trial evaluations since the last commit
+        self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
         self._frames: dict = {}    # (finger, t) -> its frame, for the latest times
         self._turns: dict = {}     # t -> the drum's turning since t = 0
         self._start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
@@ -339,6 +352,7 @@ class FingerForces:
         out = self._evaluate(t, y, commit)
         if commit:
             self._memo.clear()
+            self._margins.clear()
         elif len(self._memo) > 16:
             self._memo.pop(next(iter(self._memo)))
         self._memo[key] = out
@@ -382,8 +396,36 @@ class FingerForces:
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
             shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
-            states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares))
+            states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
         return loads, states
+
+    @property
+    def can_reverse(self) -> bool:
+        """Whether any finger's friction can reverse (planar fingers, µ > 0)."""
+        return any(m.reverses for m in self.models)
+
+    def reversal_margin(self, t: float, y: np.ndarray) -> float:
+        """The least friction-reversal margin (m/s, :meth:`PlanarFinger.
+        reversal_margin`) of the fingers touching the bird at (t, y) with the
+        friction of their last accepted contact; NO_REVERSAL where none can
+        reverse. Below zero a finger's friction turns: the integrator locates
+        that instant as an event instead of deciding it at the next accepted
+        step. (A finger that touches again after a trial without contact
+        starts from first touch with a guessed friction, which the next
+        accepted instant settles: not a reversal.)"""
+        key = (t, y.tobytes())
+        if key not in self._margins:
+            if len(self._margins) > 16:
+                self._margins.clear()
+            _, states = self.evaluate(t, y)
+            self._margins[key] = min([NO_REVERSAL] + [
+                self.models[i].reversal_margin(st.continued, lambda shape, i=i: self._kinematics(
+                    i, t, y, shape))
+                for i, st in enumerate(states)
+                if self.models[i].reverses and st.point is not None and st.continued is not None
+                and self.states[i] is not None
+                and st.continued.tau_mu == self.states[i].tau_mu])
+        return self._margins[key]
 
     def _shares(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, p_w: np.ndarray
                 ) -> tuple[float, float]:

@@ -142,6 +142,13 @@ SLIP_TOL = 1e-9
 #: (N in newtons, slip in m/s, gap in m, times in s)
 EVENT_ARM = {"lift-off": 1e-9, "slip": 1e-9, "stick": 1e-9, "touch-down": 0.0,
              "belt slows": 0.0, "belt steady": 0.0}
+#: events armed by every accepted instant itself: it settles every finger's
+#: friction, leaving each reversal margin positive
+ARMED_BY_COMMIT = ("friction reverses",)
+#: an event is handled where its function is at most minus this (its units):
+#: a friction turns where the committed contact, solved again to rounding,
+#: agrees that it must (1e-9 m/s: 1e-9 to 1e-7 s past the crossing)
+EVENT_DEPTH = {"friction reverses": 1e-9}
 #: this many events within a nanosecond is chattering: the run stops and says so
 MAX_EVENTS_AT_ONCE = 20
 #: a belt mode's normal force may dip below zero by this fraction of the
@@ -196,6 +203,8 @@ def _events(grasp: Grasp, mode: str, slip_sign: float):
         ev["stick"] = lambda t, y: slip_sign * dyn.slip(y, grasp.belt(t)[0])
     if mode == "air":
         ev["touch-down"] = lambda t, y: dyn.gap(y) + GAP_TOL
+    if grasp.fingers.can_reverse:
+        ev["friction reverses"] = grasp.fingers.reversal_margin
     conv = grasp.conveyor
     if conv.decelerates and grasp.start is None and conv.start_position is not None:
         ev["belt slows"] = lambda t, y: conv.start_position - y[0]
@@ -209,8 +218,8 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
     """New (mode, slip sign, state) after an event."""
     if name == "belt slows":
         grasp.start = t
-    if name in ("belt slows", "belt steady"):
-        return mode, slip_sign, y
+    if name in ("belt slows", "belt steady", "friction reverses"):
+        return mode, slip_sign, y           # the friction turns as the instant is committed
     if name == "lift-off":
         return "air", 0.0, y
     if name == "slip":                        # the friction reached the cone: slip begins
@@ -240,8 +249,9 @@ def _keep(grasp: Grasp, traj: Trajectory, record: Record) -> bool:
     return False
 
 
-def _locate(f, dense, t_old: float, t_new: float) -> float:
-    """Where g(t) = f(t, dense(t)) crosses zero in [t_old, t_new].
+def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
+    """Where g(t) = f(t, dense(t)) crosses zero in [t_old, t_new]: the first
+    time found with g ≤ -depth just past the crossing.
 
     Finger forces are continued from the latest solution, so g at the
     dense-output points may differ from the step's end values by the Newton
@@ -249,11 +259,30 @@ def _locate(f, dense, t_old: float, t_new: float) -> float:
     """
     g = lambda tt: f(tt, dense(tt))  # noqa: E731
     g_lo, g_hi = g(t_old), g(t_new)
-    if g_lo <= 0:
+    if g_lo <= -depth:
         return t_old
-    if g_hi > 0:
+    if g_hi > -depth:
         return t_new
-    return brentq(g, t_old, t_new, xtol=1e-12)
+    tau, dt = brentq(lambda tt: g(tt) + depth, t_old, t_new, xtol=1e-12), 1e-12
+    # brentq's answer lies within xtol of the crossing, on either side
+    while tau < t_new and g(tau) > -depth:
+        tau, dt = min(tau + dt, t_new), 2 * dt
+    return tau
+
+
+def _commit(grasp: Grasp, t: float, y: np.ndarray, mode: str, slip_sign: float):
+    """Accept (t, y): the fingers' friction settles. Where one turned (a new
+    smooth piece) the belt contact is decided again under the new forces
+    before the instant is recorded (the old mode could need N < 0).
+    Returns (record, mode, slip sign, state, whether a friction turned)."""
+    before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
+    record = grasp.record(t, y, mode, slip_sign)
+    after = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
+    turned = any(a is not None and b is not None and a != b for a, b in zip(before, after))
+    if turned and mode != "air":
+        mode, slip_sign, y = decide_mode(grasp, t, y)
+        record = grasp.record(t, y, mode, slip_sign)
+    return record, mode, slip_sign, y, turned
 
 
 def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, progress):
@@ -271,7 +300,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
         restart = False
         while not restart and stepper.status == "running":
             t_old, y_old = stepper.t, stepper.y.copy()
-            g_old = {k: f(t_old, y_old) for k, f in events.items()}
+            g_old = {k: np.inf if k in ARMED_BY_COMMIT else f(t_old, y_old)
+                     for k, f in events.items()}
             msg = stepper.step()
             if stepper.status == "failed":
                 traj.ok, traj.message = False, f"integrator failed at t = {t_old:.4f} s: {msg}"
@@ -285,8 +315,9 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
             for name, f in events.items():
                 # armed only once clearly positive: a switch leaves its new mode's
                 # event functions at zero, and rounding must not switch back
-                if g_old[name] > EVENT_ARM[name] and f(t_new, y_new) <= 0:
-                    hits.append((_locate(f, dense, t_old, t_new), name))
+                depth = EVENT_DEPTH.get(name, 0.0)
+                if g_old[name] > EVENT_ARM.get(name, 0.0) and f(t_new, y_new) <= -depth:
+                    hits.append((_locate(f, dense, t_old, t_new, depth), name))
             if hits:
                 tau, name = min(hits)
                 if len(traj.events) >= MAX_EVENTS_AT_ONCE and \
@@ -298,22 +329,13 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 traj.events.append((float(tau), name))
                 mode, slip_sign, y = _after_event(grasp, name, tau, dense(tau), mode, slip_sign)
                 t = tau
-                if not _keep(grasp, traj, grasp.record(t, y, mode, slip_sign)):
+                record, mode, slip_sign, y, _ = _commit(grasp, t, y, mode, slip_sign)
+                if not _keep(grasp, traj, record):
                     return traj
                 restart = True
                 continue
-            before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
-            record = grasp.record(t_new, y_new, mode, slip_sign)
-            after = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
-            t, y = t_new, y_new
-            if any(a is not None and b is not None and a != b for a, b in zip(before, after)):
-                # a finger's friction turned: a new smooth piece, and the belt
-                # contact must be decided again under the new forces before the
-                # instant is recorded (the old mode could need N < 0)
-                restart = True
-                if mode != "air":
-                    mode, slip_sign, y = decide_mode(grasp, t, y)
-                    record = grasp.record(t, y, mode, slip_sign)
+            t = t_new
+            record, mode, slip_sign, y, restart = _commit(grasp, t, y_new, mode, slip_sign)
             if not _keep(grasp, traj, record):
                 return traj
             if progress and t - last_report >= 0.1:
