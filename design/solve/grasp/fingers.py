@@ -399,18 +399,23 @@ class FingerForces:
             states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
         return loads, states
 
-    @property
-    def can_reverse(self) -> bool:
-        """Whether any finger's friction can reverse (planar fingers, µ > 0)."""
-        return any(m.reverses for m in self.models)
+    def snapshot(self) -> tuple[list, list]:
+        """The contacts to continue from (accepted and latest), to go back to."""
+        return list(self.states), list(self.trials)
+
+    def restore(self, snapshot: tuple[list, list]) -> None:
+        """Go back to a :meth:`snapshot`: an accepted instant is withdrawn."""
+        self.states, self.trials = list(snapshot[0]), list(snapshot[1])
+        self._memo.clear()
+        self._margins.clear()
 
     def reversal_margin(self, t: float, y: np.ndarray) -> float:
         """The least friction-reversal margin (m/s, :meth:`PlanarFinger.
         reversal_margin`) of the fingers touching the bird at (t, y) with the
         friction of their last accepted contact; NO_REVERSAL where none can
-        reverse. Below zero a finger's friction turns: the integrator locates
-        that instant as an event instead of deciding it at the next accepted
-        step. (A finger that touches again after a trial without contact
+        reverse. Below zero a finger's friction turns: the integrator, finding
+        a friction turned at an accepted instant, locates where within the
+        step it did and accepts that instant instead. (A finger that touches again after a trial without contact
         starts from first touch with a guessed friction, which the next
         accepted instant settles: not a reversal.)"""
         key = (t, y.tobytes())

@@ -147,13 +147,10 @@ SLIP_TOL = 1e-9
 #: (N in newtons, slip in m/s, gap in m, times in s)
 EVENT_ARM = {"lift-off": 1e-9, "slip": 1e-9, "stick": 1e-9, "touch-down": 0.0,
              "belt slows": 0.0, "belt steady": 0.0}
-#: events armed by every accepted instant itself: it settles every finger's
-#: friction, leaving each reversal margin positive
-ARMED_BY_COMMIT = ("friction reverses",)
-#: an event is handled where its function is at most minus this (its units):
-#: a friction turns where the committed contact, solved again to rounding,
-#: agrees that it must (1e-9 m/s: 1e-9 to 1e-7 s past the crossing)
-EVENT_DEPTH = {"friction reverses": 1e-9}
+#: a friction reversal is committed where the reversal margin is at most
+#: minus this (m/s), so that the contact solved again from the accepted
+#: state agrees, to rounding, that it turns (1e-9 to 1e-7 s past the crossing)
+REVERSAL_DEPTH = 1e-9
 #: this many events within a nanosecond is chattering: the run stops and says so
 MAX_EVENTS_AT_ONCE = 20
 #: a belt mode's normal force may dip below zero by this fraction of the
@@ -208,8 +205,6 @@ def _events(grasp: Grasp, mode: str, slip_sign: float):
         ev["stick"] = lambda t, y: slip_sign * dyn.slip(y, grasp.belt(t)[0])
     if mode == "air":
         ev["touch-down"] = lambda t, y: dyn.gap(y) + GAP_TOL
-    if grasp.fingers.can_reverse:
-        ev["friction reverses"] = grasp.fingers.reversal_margin
     conv = grasp.conveyor
     if conv.decelerates and grasp.start is None and conv.start_position is not None:
         ev["belt slows"] = lambda t, y: conv.start_position - y[0]
@@ -223,8 +218,8 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
     """New (mode, slip sign, state) after an event."""
     if name == "belt slows":
         grasp.start = t
-    if name in ("belt slows", "belt steady", "friction reverses"):
-        return mode, slip_sign, y           # the friction turns as the instant is committed
+    if name in ("belt slows", "belt steady"):
+        return mode, slip_sign, y
     if name == "lift-off":
         return "air", 0.0, y
     if name == "slip":                        # the friction reached the cone: slip begins
@@ -305,8 +300,7 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
         restart = False
         while not restart and stepper.status == "running":
             t_old, y_old = stepper.t, stepper.y.copy()
-            g_old = {k: np.inf if k in ARMED_BY_COMMIT else f(t_old, y_old)
-                     for k, f in events.items()}
+            g_old = {k: f(t_old, y_old) for k, f in events.items()}
             msg = stepper.step()
             if stepper.status == "failed":
                 traj.ok, traj.message = False, f"integrator failed at t = {t_old:.4f} s: {msg}"
@@ -320,9 +314,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
             for name, f in events.items():
                 # armed only once clearly positive: a switch leaves its new mode's
                 # event functions at zero, and rounding must not switch back
-                depth = EVENT_DEPTH.get(name, 0.0)
-                if g_old[name] > EVENT_ARM.get(name, 0.0) and f(t_new, y_new) <= -depth:
-                    hits.append((_locate(f, dense, t_old, t_new, depth), name))
+                if g_old[name] > EVENT_ARM[name] and f(t_new, y_new) <= 0:
+                    hits.append((_locate(f, dense, t_old, t_new), name))
             if hits:
                 tau, name = min(hits)
                 if len(traj.events) >= MAX_EVENTS_AT_ONCE and \
@@ -339,8 +332,17 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                     return traj
                 restart = True
                 continue
-            t = t_new
-            record, mode, slip_sign, y, restart = _commit(grasp, t, y_new, mode, slip_sign)
+            snapshot = grasp.fingers.snapshot()
+            t, committed = t_new, _commit(grasp, t_new, y_new, mode, slip_sign)
+            if committed[4]:
+                # a finger's friction turned within the step: it turns where its
+                # reversal margin (with the friction it had) crosses zero
+                grasp.fingers.restore(snapshot)
+                t = _locate(grasp.fingers.reversal_margin, dense, t_old, t_new, REVERSAL_DEPTH)
+                traj.events.append((float(t), "friction reverses"))
+                committed = _commit(grasp, t, dense(t), mode, slip_sign)
+                restart = True
+            record, mode, slip_sign, y, _ = committed
             if not _keep(grasp, traj, record):
                 return traj
             if progress and t - last_report >= 0.1:
