@@ -364,9 +364,11 @@ def test_a_trial_in_one_newton_solve_is_the_stepped_continuation(shift):
     Newton solve on the section as a conic, in one compiled call) gives the
     contact the stepped continuation gives from the same state (solve_frame,
     friction kept): force and angle to 1e-9 relative (both solve to a 1e-12
-    residual; the conic and the axes forms of the ellipse round differently)."""
+    residual; the conic and the axes forms of the ellipse round differently).
+    The grasp scenes' 6-interval mesh, whose compiled functions the suite
+    builds anyway on an empty cache."""
     pose, ell_w = CASE1
-    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4)
+    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4, intervals=6)
     _, state = solver.solve_frame(ell, "push", None, None)
     moved = ell.shifted(0.0, shift)
     trial = solver.continue_trial(state, *_conic(moved))
@@ -387,7 +389,7 @@ def test_a_trial_that_needs_more_than_one_newton_solve_is_left_to_the_steps():
     straight finger (a release), or so far that Newton from the old state does
     not converge within MAX_STEP_ITERATIONS."""
     pose, ell_w = CASE1
-    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4)
+    ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4, intervals=6)
     _, state = solver.solve_frame(ell, "push", None, None)
     clear = ell.shifted(0.0, -0.15)
     assert segment_overlap(clear, solver.finger.length) >= 0.0
