@@ -284,7 +284,6 @@ class FingerForces:
         self.drum = grasper.drum(drum_speed)
         kind = FINGER_MODELS[model]
         self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
-        self.windows = windows
         self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved
@@ -415,9 +414,10 @@ class FingerForces:
         friction of their last accepted contact; NO_REVERSAL where none can
         reverse. Below zero a finger's friction turns: the integrator, finding
         a friction turned at an accepted instant, locates where within the
-        step it did and accepts that instant instead. (A finger that touches again after a trial without contact
-        starts from first touch with a guessed friction, which the next
-        accepted instant settles: not a reversal.)"""
+        step it did and accepts that instant instead. (A finger that touches
+        again after a trial without contact starts from first touch with a
+        guessed friction, which the next accepted instant settles: not a
+        reversal.)"""
         key = (t, y.tobytes())
         if key not in self._margins:
             if len(self._margins) > 16:
