@@ -40,10 +40,11 @@ def hard_fine():
 
 def test_default_integrator_is_within_target_of_a_4x_finer_run(hard, hard_fine):
     """Issue 4's targets: hold time within 1%, peak finger force within 2%.
-    Measured: 0.04 % and 0.02 % (the peak being finger 5a's beyond its fold),
-    since the fingers' friction reversals are located as events; decided at
-    the accepted steps instead they came 0.35 % and 1.96 % off, hence the
-    0.2 % bounds."""
+    Measured at the default 10 ms steps: 0.003 % and 0.017 % (the peak being
+    finger 5a's beyond its fold; 0.04 % and 0.02 % at 5 ms), since the
+    fingers' friction reversals are located as events and each finger's
+    maxima between the steps; with reversals decided at the accepted steps
+    (5 ms) they came 0.35 % and 1.96 % off, hence the 0.2 % bounds."""
     a, b = hard.summary, hard_fine.summary
     assert a["hold_time_s"] > 0.15
     assert a["hold_time_s"] == pytest.approx(b["hold_time_s"], rel=0.01)
@@ -61,10 +62,10 @@ def test_thesis_bdf4_with_frozen_forces_is_far_off(hard_fine):
     belt (the hold splits into 5 windows against 2); at a quarter of the step
     it meets issue 4's targets against the 4x finer adaptive run (hold within
     1 %, peak within 2 %), which makes it benchmarks/grasp.py's second
-    baseline. Measured: 0.39 %, 1.16 % (0.2 %, 0.5 % against the reference
-    before the adaptive run located its friction reversals as events; at an
-    eighth of the step the peak is 4.2 % off: frozen forces do not converge
-    steadily)."""
+    baseline. Measured: 0.39 %, 1.16 % (the same against the reference at
+    5 ms steps; 0.2 %, 0.5 % before the adaptive run located its friction
+    reversals as events; at an eighth of the step the peak is 4.2 % off:
+    frozen forces do not converge steadily)."""
     s = thesis_grasp_setup(SKIP, DURATION, "hard")
     coarse = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=5.6e-3)).summary
     fine = simulate_grasp(s, IntegratorSettings(integrator="bdf4", step=1.4e-3)).summary
@@ -115,9 +116,13 @@ def test_summary_fields(hard):
     # N = 0 inside the window, > 0 just outside
     inside = [r for r in hard.trajectory.records if a < r.t < b]
     assert inside and all(r.normal == 0.0 and r.mode == "air" for r in inside)
+    # the peak is a recorded instant's or one located between them, never below the records'
     t_peak = s["max_finger_force_time_s"]
-    peak = max(f.magnitude for r in hard.trajectory.records if r.t == t_peak for f in r.fingers)
-    assert peak == s["max_finger_force_N"]
+    at = [f.magnitude for r in hard.trajectory.records if r.t == t_peak for f in r.fingers]
+    located = [f for t, f in hard.trajectory.peaks.values() if t == t_peak]
+    assert max(at + located) == s["max_finger_force_N"]
+    assert s["max_finger_force_N"] >= max(f.magnitude for r in hard.trajectory.records
+                                          for f in r.fingers)
     np.testing.assert_allclose(s["centre_rise_m"],
                                max(r.y[1] for r in hard.trajectory.records) - hard.trajectory.records[0].y[1])
 

@@ -139,10 +139,13 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
             ("population" in data and population is None):
         return None
     # the loop's simulations use the scene's integrator, no looser than the
-    # loop's own tolerances (trust_region.LOOP_SIMULATOR), with the NLP's finger mesh
+    # loop's own tolerances (trust_region.LOOP_SIMULATOR), with steps no longer
+    # than the NLP's time grid (whose view of a design must reproduce them; the
+    # verification runs at a quarter of it), with the NLP's finger mesh
     given, tight = scene.settings.integrator, LOOP_SIMULATOR
     settings = replace(settings, simulator=replace(
-        given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol)))
+        given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol),
+        max_step=min(given.max_step, settings.nlp.time_step)))
     solver = data.get("solver", {})
     if "beam_intervals" not in solver:       # the finger mesh: the scene's unless given
         nodes = scene.settings.contact_nodes

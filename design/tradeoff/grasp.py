@@ -25,15 +25,15 @@ DEFAULT = IntegratorSettings()
 #: the integrator settings studied: short name -> settings
 CASES = {
     "adaptive rk45 (default)": DEFAULT,
-    "adaptive rk45, max step 10 ms": IntegratorSettings(max_step=1e-2),
-    "adaptive rk45, max step 2.5 ms": IntegratorSettings(max_step=2.5e-3),
+    "adaptive rk45, max step 5 ms": IntegratorSettings(max_step=5e-3),
+    "adaptive rk45, max step 20 ms": IntegratorSettings(max_step=2e-2),
     "adaptive rk45, rtol 1e-6": IntegratorSettings(rtol=1e-6, atol=1e-8),
     "adaptive dop853": IntegratorSettings(stepper="dop853"),
     "bdf4 (thesis) 16.6 ms": IntegratorSettings(integrator="bdf4", step=16.6e-3),
     "bdf4 (thesis) 5.6 ms": IntegratorSettings(integrator="bdf4", step=5.6e-3),
     "bdf4 1.4 ms": IntegratorSettings(integrator="bdf4", step=1.4e-3),
 }
-QUICK_CASES = ("adaptive rk45 (default)", "adaptive rk45, max step 10 ms",
+QUICK_CASES = ("adaptive rk45 (default)", "adaptive rk45, max step 5 ms",
                "bdf4 (thesis) 5.6 ms")
 #: the reference's resolution, times the default's
 REFERENCE_FACTOR = 4.0

@@ -398,6 +398,18 @@ class FingerForces:
             states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
         return loads, states
 
+    def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
+        """The fingers' states at (t, y), a trial evaluation continued from an
+        earlier :meth:`snapshot`, leaving this object exactly as it was (a
+        look inside an accepted step that changes nothing after it)."""
+        kept = self.states, self.trials, self._memo, self._margins
+        self.states, self.trials = list(snapshot[0]), list(snapshot[1])
+        self._memo, self._margins = {}, {}
+        try:
+            return self._evaluate(t, y, commit=False)[1]
+        finally:
+            self.states, self.trials, self._memo, self._margins = kept
+
     def snapshot(self) -> tuple[list, list]:
         """The contacts to continue from (accepted and latest), to go back to."""
         return list(self.states), list(self.trials)

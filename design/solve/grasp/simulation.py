@@ -12,6 +12,7 @@ from design.physics.bird import Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
 from design.solve.grasp.fingers import FingerForces, reach_windows
 from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, integrate
+from design.solve.grasp.peaks import merged_peaks
 from design.solve.grasp.validity import contact_validity
 
 
@@ -124,7 +125,8 @@ def summarise(run: GraspRun) -> dict:
     windows = hold_windows(run)
     names = [gf.name for gf in run.setup.grasper.fingers]
     force = np.array([[f.magnitude for f in r.fingers] for r in recs])
-    k, j = np.unravel_index(np.argmax(force), force.shape)
+    peak, when = merged_peaks(force, np.array([r.t for r in recs]), run.trajectory.peaks)
+    j = int(np.argmax(peak))
     z = np.array([r.y[1] for r in recs])
     gap = z - np.array([BirdDynamics(run.setup.bird, run.setup.legs, 0.0).support(r.y[2])[1]
                         for r in recs])
@@ -133,10 +135,10 @@ def summarise(run: GraspRun) -> dict:
         "hold_windows": [[a, b] for a, b in windows],
         "hold_time_s": max((b - a for a, b in windows), default=0.0),
         "total_hold_s": sum(b - a for a, b in windows),
-        "max_finger_force_N": float(force[k, j]),
+        "max_finger_force_N": float(peak[j]),
         "max_finger_force_finger": names[j],
-        "max_finger_force_time_s": recs[k].t,
-        "max_force_per_finger_N": {n: float(v) for n, v in zip(names, force.max(axis=0))},
+        "max_finger_force_time_s": float(when[j]),
+        "max_force_per_finger_N": {n: float(v) for n, v in zip(names, peak)},
         "centre_rise_m": float(z.max() - z[0]),
         "belt_clearance_m": float(gap.max()),
         "max_pitch_rad": float(np.max(np.abs([r.y[2] for r in recs]))),
