@@ -13,7 +13,10 @@ accepted instant; each accepted instant settles it, and the stepper restarts
 when one turns. Located as an event, a reversal comes where the sliding
 says, not up to a step late: that made the default run's hold and peak
 force depend on where the steps fell (0.35 % and 1.96 % from a 4x finer
-run on the hard-finger mean bird, 0.04 % and 0.02 % now).
+run on the hard-finger mean bird, 0.04 % and 0.02 % now). A finger's force
+maxima between accepted instants are located on the dense output
+(design/solve/grasp/peaks.py), so that the peak force does not depend on
+the step either.
 
 BDF-4 (``bdf4``, thesis §4.4): fixed step h, forces frozen over the step,
 conveyor friction sign updated at the end of the step, the conveyor contact
