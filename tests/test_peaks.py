@@ -3,9 +3,12 @@
 the hard-finger mean bird that locating them leaves the integration as it
 was and makes the peak independent of where the steps fall."""
 
+import re
+
 import numpy as np
 import pytest
 
+from design.reproduce.grasp_rows import peak_split
 from design.solve.grasp import peaks
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.peaks import PEAK_RTOL, interpolated_maximum
@@ -77,3 +80,18 @@ def test_located_peaks_are_the_fine_run_s(runs):
     worst_located = max(abs(got[n] / ref[n] - 1) for n in touched)
     assert worst_located < 5e-3 and worst_sampled > 1e-2
     assert all(got[n] >= rec[n] for n in rec)
+
+
+def test_the_summary_s_peak_can_be_read_back_where_it_was_located(runs):
+    """The peak's contact (run.peak) is the located one when the peak lies
+    between records, and the reproduction's split of it into world
+    components adds up to its magnitude."""
+    located, sampled, _ = runs
+    t, y, state = located.peak()
+    s = located.summary
+    assert (t, state.magnitude) == (s["max_finger_force_time_s"], s["max_finger_force_N"])
+    assert all(r.t != t for r in located.trajectory.records)     # between records here
+    assert sampled.peak()[2].magnitude == sampled.summary["max_finger_force_N"]
+    parts = re.search(r"= \(([-+\d.]+), ([-+\d.]+), ([-+\d.]+)\) N", peak_split(located))
+    assert np.linalg.norm([float(v) for v in parts.groups()]) == pytest.approx(
+        state.magnitude, abs=0.1)

@@ -11,7 +11,6 @@ the order of", "around": 30 %). SI: m, N, s, rad.
 
 from __future__ import annotations
 
-from dataclasses import replace
 
 import numpy as np
 
@@ -160,11 +159,9 @@ def peak_split(run: GraspRun) -> str:
     """The peak finger force in parts: world components (right drum; the
     left drum's mirror has Y reversed), and the push along the bird's
     surface normal against the friction along its surface."""
-    recs = run.trajectory.records
-    k = next(i for i, r in enumerate(recs) if r.t == run.summary["max_finger_force_time_s"])
-    j = [gf.name for gf in run.setup.grasper.fingers].index(run.summary["max_finger_force_finger"])
-    state, b = recs[k].fingers[j], run.setup.bird
-    rotation = rot_y(recs[k].y[2])
+    _, y, state = run.peak()
+    b = run.setup.bird
+    rotation = rot_y(y[2])
     normal = rotation @ (state.body_point / np.array([b.eta, b.lam, b.gamma]) ** 2)
     push = -float(state.force @ normal / np.linalg.norm(normal))
     friction = float(np.sqrt(max(state.force @ state.force - push ** 2, 0.0)))

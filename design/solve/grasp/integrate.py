@@ -95,8 +95,8 @@ class Trajectory:
     ok: bool = True
     #: stopped by IntegratorSettings.max_wall_time (not ok, but no failure)
     out_of_time: bool = False
-    #: finger index -> (t s, force N): its largest force, found between
-    #: accepted instants where it exceeds the records' (design/solve/grasp/peaks.py)
+    #: finger index -> its largest force found between accepted instants,
+    #: where it exceeds the records' (design/solve/grasp/peaks.py's Peak)
     peaks: dict = field(default_factory=dict)
 
     def over_budget(self, started: float, budget: float | None, t: float, t_end: float) -> bool:

@@ -25,6 +25,20 @@ PEAK_EVALUATIONS = 8
 
 
 @dataclass(frozen=True)
+class Peak:
+    """A finger's force maximum found between accepted instants: time (s),
+    the bird's state there, the finger's contact."""
+
+    t: float
+    y: np.ndarray
+    state: object
+
+    @property
+    def force(self) -> float:
+        return self.state.magnitude
+
+
+@dataclass(frozen=True)
 class Span:
     """One accepted step: from ``t0`` to ``t1`` (s), its dense output, and the
     fingers' snapshot it was integrated from."""
@@ -36,14 +50,14 @@ class Span:
 
 
 class PeakFinder:
-    """The largest force (N) of each finger and its time (s), found between
-    the last three accepted instants after each step (``peaks``: finger
-    index -> (t, force)); the instants themselves are the records'."""
+    """Each finger's largest force found between the last three accepted
+    instants after each step (``peaks``: finger index -> :class:`Peak`,
+    where it exceeds the records'); the instants themselves are the records'."""
 
     def __init__(self, fingers):
         self.fingers = fingers
         self.spans: deque[Span] = deque(maxlen=2)
-        self.peaks: dict[int, tuple[float, float]] = {}
+        self.peaks: dict[int, Peak] = {}
         self.evaluations = 0
 
     def accepted(self, span: Span, records: list) -> None:
@@ -56,21 +70,22 @@ class PeakFinder:
         first, second = self.spans
         if not (first.t0 == a.t and first.t1 == b.t == second.t0 and second.t1 == c.t):
             return
-        probed: dict[float, list] = {}
+        probed: dict[float, tuple] = {}
 
         def force(t: float, j: int) -> float:
             if t not in probed:
                 span = first if t <= first.t1 else second
+                y = span.dense(t)
                 self.evaluations += 1
-                probed[t] = self.fingers.probe(t, span.dense(t), span.snapshot)
-            return probed[t][j].magnitude
+                probed[t] = y, self.fingers.probe(t, y, span.snapshot)
+            return probed[t][1][j].magnitude
 
         for j, (fa, fb, fc) in enumerate(zip(*([f.magnitude for f in r.fingers]
                                                 for r in (a, b, c)))):
             if fb > 0.0 and fb > fa and fb >= fc:
                 t, f = interpolated_maximum(lambda t, j=j: force(t, j), a.t, b.t, c.t, fa, fb, fc)
-                if f > fb and f > self.peaks.get(j, (0.0, 0.0))[1]:
-                    self.peaks[j] = (t, f)
+                if f > fb and (j not in self.peaks or f > self.peaks[j].force):
+                    self.peaks[j] = Peak(t, probed[t][0], probed[t][1][j])
 
 
 def interpolated_maximum(f: Callable[[float], float], a: float, b: float, c: float,
@@ -97,13 +112,13 @@ def interpolated_maximum(f: Callable[[float], float], a: float, b: float, c: flo
     return b, fb
 
 
-def merged_peaks(force: np.ndarray, times: np.ndarray, peaks: dict[int, tuple[float, float]]
+def merged_peaks(force: np.ndarray, times: np.ndarray, peaks: dict[int, Peak]
                  ) -> tuple[np.ndarray, np.ndarray]:
     """Each finger's largest force (N) and its time (s): over the records
     (``force`` records x fingers, ``times``) and the maxima found between them."""
     k = np.argmax(force, axis=0)
     best, when = force[k, np.arange(force.shape[1])], times[k]
-    for j, (t, f) in peaks.items():
-        if f > best[j]:
-            best[j], when[j] = f, t
+    for j, p in peaks.items():
+        if p.force > best[j]:
+            best[j], when[j] = p.force, p.t
     return best, when

@@ -10,7 +10,7 @@ import numpy as np
 
 from design.physics.bird import Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
-from design.solve.grasp.fingers import FingerForces, reach_windows
+from design.solve.grasp.fingers import FingerForces, FingerState, reach_windows
 from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, integrate
 from design.solve.grasp.peaks import merged_peaks
 from design.solve.grasp.validity import contact_validity
@@ -53,6 +53,17 @@ class GraspRun:
         """:func:`summarise`, computed once (0.09 s for a 0.6 s mean-bird run;
         the design loop reads it dozens of times per simulation)."""
         return summarise(self)
+
+    def peak(self) -> tuple[float, np.ndarray, FingerState]:
+        """The summary's peak finger force: (time s, the bird's state, the
+        finger's contact), at a record or located between records."""
+        s = self.summary
+        j = [gf.name for gf in self.setup.grasper.fingers].index(s["max_finger_force_finger"])
+        located = self.trajectory.peaks.get(j)
+        if located is not None and located.t == s["max_finger_force_time_s"]:
+            return located.t, located.y, located.state
+        r = next(r for r in self.trajectory.records if r.t == s["max_finger_force_time_s"])
+        return r.t, r.y, r.fingers[j]
 
 
 def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = IntegratorSettings(),
