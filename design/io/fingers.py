@@ -75,7 +75,7 @@ def _section_rigidities(reader: Reader, data: dict, field: str, stiffness: Stiff
     if "EI" in data:
         for key in ("I_out", "J", "poisson"):
             if key in data:
-                reader.add(join(field, key), f"goes with E and I; with EI give EI_out and GJ")
+                reader.add(join(field, key), "goes with E and I; with EI give EI_out and GJ")
         out = [reader.quantity(data, key, field, "flexural_rigidity", lo=0.0, lo_open=True,
                                default=None) for key in ("EI_out", "GJ")]
         return tuple(None if v is None else UniformEI(v) for v in out)

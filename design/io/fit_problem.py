@@ -255,7 +255,6 @@ def read_finger_data(reader: Reader, path: Path, length: float,
     rows = list(zip(*(table[k] for k in ("F", "alpha", "at", "s", "x", "y", "psi", "_line"))))
     cases: dict[tuple, int] = {}
     obs = []
-    span = interval(0, length, True, False)
     for F, alpha, at, s, x, y, psi, line in rows:
         where = f"line {line}"
         ok = True

@@ -11,7 +11,6 @@ from pathlib import Path
 
 import yaml
 
-from design.errors import ProblemFileError
 from design.io.beam_scene import read_beam
 from design.io.contact_scene import read_contact
 from design.io.design_problem import read_design

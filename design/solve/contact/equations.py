@@ -35,7 +35,7 @@ import numpy as np
 from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, level_casadi,
                                     level_conic)
 from design.physics.stiffness import Stiffness
-from design.solve.beam.collocation import BeamTranscription, transcription
+from design.solve.beam.collocation import transcription
 from design.solve.newton import NewtonCache, compiled_jacobian
 
 MODES = ("interior", "tip")
