@@ -138,8 +138,8 @@ def test_a_multistart_lists_its_distinct_optima_and_takes_the_best_verified():
     from design.run.solve import _rank, multistart_summary
 
     def result(start, status, hold, d):
-        return {"status": status, "start_index": start, "d": d,
-                "design": {"groups.upper.stiffness_scale": 0.5 + d[0]},
+        return {"status": status, "message": f"start {start}: {status}", "start_index": start,
+                "d": d, "design": {"groups.upper.stiffness_scale": 0.5 + d[0]},
                 "verification": {"hold_time_s": hold, "max_finger_force_N": 20.0 + start}}
 
     results = {"s0": result(0, "verified", 0.30, [0.10]),
@@ -151,5 +151,7 @@ def test_a_multistart_lists_its_distinct_optima_and_takes_the_best_verified():
     assert [o["starts"] for o in summary["optima"]] == [[1, 2], [0]]     # best first
     assert summary["optima"][0]["verified_hold_time_s"] == 0.35
     assert summary["unverified_starts"] == [3] and summary["seed"] == 5
+    # every start says how it ended, in its own words
+    assert summary["starts"][3]["message"] == "start 3: failed verification"
     # an unverified longer hold never wins over a verified one
     assert max(results, key=lambda k: _rank(results[k])) == "s2"

@@ -302,7 +302,7 @@ def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[st
     """The starts of one cap and the distinct optima they reached
     (design/solve/optimize/multistart.py says when two are one)."""
     rows = [{"start": results[key].get("start_index", i), "case": key,
-             "status": results[key]["status"],
+             "status": results[key]["status"], "message": results[key]["message"],
              "verified_hold_time_s": results[key]["verification"]["hold_time_s"],
              "verified_max_finger_force_N": results[key]["verification"]["max_finger_force_N"],
              **results[key]["design"]} for i, key in enumerate(keys)]
