@@ -95,3 +95,15 @@ def test_the_summary_s_peak_can_be_read_back_where_it_was_located(runs):
     parts = re.search(r"= \(([-+\d.]+), ([-+\d.]+), ([-+\d.]+)\) N", peak_split(located))
     assert np.linalg.norm([float(v) for v in parts.groups()]) == pytest.approx(
         state.magnitude, abs=0.1)
+
+
+def test_the_validity_report_names_the_same_peaks_as_the_summary(runs):
+    """A finger's largest force in summary.validity (and its fold-force
+    warning) is the located one, not the records' lower value."""
+    located = runs[0]
+    s = located.summary
+    for name, v in s["validity"]["fingers"].items():
+        assert v["max_force_N"] == s["max_force_per_finger_N"][name]
+    for b in s["validity"]["forces_beyond_fold"]:
+        assert b["force_N"] == s["max_force_per_finger_N"][b["finger"]]
+    assert s["validity"]["forces_beyond_fold"]       # finger 5a passes its fold here

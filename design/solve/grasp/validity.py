@@ -66,12 +66,15 @@ def contact_validity(run) -> dict:
         if not touching:
             continue
         bound = fold_force(gf.finger)
-        peak = max(f.magnitude for _, f in touching)
+        # the finger's force maximum located between records, where there is one
+        located = [(p.t, p.force) for p in [run.trajectory.peaks.get(i)] if p is not None]
+        peak = max([f.magnitude for _, f in touching] + [f for _, f in located])
         per_finger[gf.name] = {
             "normal_out_of_plane_max": max(f.normal_out_of_plane for _, f in touching),
             "sweep_out_of_plane_max": max(f.sweep_out_of_plane for _, f in touching),
             "fold_force_N": bound, "max_force_N": peak}
-        over = [(r.t, f.magnitude) for r, f in touching if f.magnitude > bound]
+        over = [(r.t, f.magnitude) for r, f in touching if f.magnitude > bound] + \
+            [(t, f) for t, f in located if f > bound]
         if over:
             t, force = max(over, key=lambda p: p[1])
             beyond.append({"finger": gf.name, "time_s": t, "force_N": force, "fold_force_N": bound})
