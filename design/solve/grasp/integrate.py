@@ -53,12 +53,12 @@ class IntegratorSettings:
     #: worst error (hold, peak force) of 0.18 % against 0.11 %
     rtol: float = 1e-4
     atol: float = 1e-6
-    #: 10 ms: measured by ``python -m benchmarks.grasp`` (hard lower fingers,
-    #: planar), 0.57 s CPU per simulated second against 0.89 s at 5 ms, errors
-    #: against the 4x finer run +0.005 % / -0.010 % (hold / peak) against
-    #: +0.04 % / +0.02 %; checked, not decided, on the soft arriving bird and
-    #: the football (spatial; README, "Grasp scenes"). At 20 ms the peak, read
-    #: at the accepted steps, is 2.9 % low.
+    #: 10 ms, with the force maxima located between steps: measured by
+    #: ``python -m benchmarks.grasp`` (hard lower fingers, planar), 0.59 s wall
+    #: per simulated second against 0.86 s at 5 ms, errors against the 4x finer
+    #: run +0.003 % / +0.02 % (hold / peak) against +0.04 % / +0.05 %; checked,
+    #: not decided, on four other scenes (README, "Grasp scenes": at most
+    #: 0.27 %). At 20 ms the trajectory departs (hold +0.36 %, peak -1.2 %).
     max_step: float = 1e-2
     stepper: str = "rk45"
     step: float = 5.6e-3

@@ -58,7 +58,6 @@ class PeakFinder:
         self.fingers = fingers
         self.spans: deque[Span] = deque(maxlen=2)
         self.peaks: dict[int, Peak] = {}
-        self.evaluations = 0
 
     def accepted(self, span: Span, records: list) -> None:
         """``span`` ended at the latest record: look for each finger's maximum
@@ -76,7 +75,6 @@ class PeakFinder:
             if t not in probed:
                 span = first if t <= first.t1 else second
                 y = span.dense(t)
-                self.evaluations += 1
                 probed[t] = y, self.fingers.probe(t, y, span.snapshot)
             return probed[t][1][j].magnitude
 
