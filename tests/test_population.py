@@ -155,3 +155,28 @@ def test_a_multistart_lists_its_distinct_optima_and_takes_the_best_verified():
     assert summary["starts"][3]["message"] == "start 3: failed verification"
     # an unverified longer hold never wins over a verified one
     assert max(results, key=lambda k: _rank(results[k])) == "s2"
+
+
+def test_a_better_known_single_bird_design_is_named_not_adopted():
+    """The single-bird optimum, verified on every bird, within every cap and
+    longer for the population than the robust answer: the run says so (its
+    message and closing line), and the answer stays the robust loop's."""
+    from design.run.solve import NO_IMPROVEMENT, better_known, status_line
+
+    comparison = {"objective": "worst",
+                  "hold_time_s": {"baseline": 0.1792, "single_bird_optimum": 0.1945,
+                                  "robust_optimum": 0.1792},
+                  "within_caps": {"baseline": True, "single_bird_optimum": True,
+                                  "robust_optimum": True}}
+    note = better_known(comparison)
+    assert "0.1945 s (worst) against 0.1792 s" in note
+    over = {**comparison, "within_caps": {**comparison["within_caps"],
+                                          "single_bird_optimum": False}}
+    shorter = {**comparison, "hold_time_s": {**comparison["hold_time_s"],
+                                             "single_bird_optimum": 0.17}}
+    assert better_known(over) is None and better_known(shorter) is None
+    result = {"status": NO_IMPROVEMENT, "baseline": {"hold_time_s": 0.1792},
+              "verification": {"hold_time_s": 0.1792, "max_finger_force_N": 23.6,
+                               "cap_N": 23.6},
+              "population": {"better_known": note}}
+    assert status_line(result).endswith(note)
