@@ -141,7 +141,7 @@ def summarise(run: GraspRun) -> dict:
     z = np.array([r.y[1] for r in recs])
     gap = z - np.array([BirdDynamics(run.setup.bird, run.setup.legs, 0.0).support(r.y[2])[1]
                         for r in recs])
-    validity = contact_validity(run)
+    validity = contact_validity(run, peak, when)
     return {
         "hold_windows": [[a, b] for a, b in windows],
         "hold_time_s": max((b - a for a, b in windows), default=0.0),

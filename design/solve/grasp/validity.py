@@ -52,10 +52,12 @@ def fold_force(finger: Finger) -> float:
     return float(brentq(slope, hi / 2 if slope(hi / 2) < 0 else 0.0, hi, xtol=1e-3 * hi))
 
 
-def contact_validity(run) -> dict:
+def contact_validity(run, peaks: np.ndarray, peak_times: np.ndarray) -> dict:
     """Per finger: the largest out-of-plane shares of contact normal and sweep,
-    the fold force and where it was passed; fingers through the conveyor;
-    and whether the planar model stayed inside its limit."""
+    the fold force and whether its largest force (``peaks``, N, at
+    ``peak_times``, s: the summary's, located between records where they
+    are) passed it; fingers through the conveyor; and whether the planar
+    model stayed inside its limit."""
     recs = run.trajectory.records
     setup = run.setup
     b = setup.bird
@@ -66,18 +68,14 @@ def contact_validity(run) -> dict:
         if not touching:
             continue
         bound = fold_force(gf.finger)
-        # the finger's force maximum located between records, where there is one
-        located = [(p.t, p.force) for p in [run.trajectory.peaks.get(i)] if p is not None]
-        peak = max([f.magnitude for _, f in touching] + [f for _, f in located])
+        peak = float(peaks[i])
         per_finger[gf.name] = {
             "normal_out_of_plane_max": max(f.normal_out_of_plane for _, f in touching),
             "sweep_out_of_plane_max": max(f.sweep_out_of_plane for _, f in touching),
             "fold_force_N": bound, "max_force_N": peak}
-        over = [(r.t, f.magnitude) for r, f in touching if f.magnitude > bound] + \
-            [(t, f) for t, f in located if f > bound]
-        if over:
-            t, force = max(over, key=lambda p: p[1])
-            beyond.append({"finger": gf.name, "time_s": t, "force_N": force, "fold_force_N": bound})
+        if peak > bound:
+            beyond.append({"finger": gf.name, "time_s": float(peak_times[i]), "force_N": peak,
+                           "fold_force_N": bound})
         for r, f in touching:
             pts = _finger_points(drum, gf, r.t, f)
             under = (pts[2] < 0) & (np.abs(pts[1]) < b.lam) & (np.abs(pts[0] - r.y[0]) < b.eta)
