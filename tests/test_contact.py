@@ -386,14 +386,20 @@ def test_a_trial_that_needs_more_than_one_newton_solve_is_left_to_the_steps():
     """Where one Newton solve is not the whole answer, continue_trial returns
     None and the caller takes the stepped path: the object moved clear of the
     straight finger (a release), or so far that Newton from the old state does
-    not converge within MAX_STEP_ITERATIONS."""
+    not converge within MAX_STEP_ITERATIONS. A long move that Newton does
+    converge (undamped: no line search) must land on the stepped path's
+    solution."""
     pose, ell_w = CASE1
     ell, solver = pose.view(ell_w), RobustContact(thesis_finger(), 0.4, intervals=6)
     _, state = solver.solve_frame(ell, "push", None, None)
     clear = ell.shifted(0.0, -0.15)
     assert segment_overlap(clear, solver.finger.length) >= 0.0
     assert solver.continue_trial(state, *_conic(clear)) is None
-    far = ell.shifted(-0.03, 0.01)                      # 6.3 N -> 74 N
+    far = ell.shifted(-0.04, 0.01)                      # 6.3 N -> 212 N
     assert solver.continue_trial(state, *_conic(far)) is None
     sol, _ = solver.solve_frame(far, "auto", None, state, settle=False, detail=False)
-    assert sol.converged and sol.force > 10 * state.post[3]   # the steps get there
+    assert sol.converged and sol.force > 30 * state.post[3]   # the steps get there
+    long = ell.shifted(-0.03, 0.01)                     # 6.3 N -> 74 N in one solve
+    trial = solver.continue_trial(state, *_conic(long))
+    stepped, _ = solver.solve_frame(long, "auto", None, state, settle=False, detail=False)
+    assert trial is not None and trial[0].force == pytest.approx(stepped.force, rel=1e-9)

@@ -36,6 +36,7 @@ from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, le
                                     level_conic)
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import transcription
+from design.solve.compiled import compiled
 from design.solve.newton import NewtonCache, compiled_jacobian
 
 MODES = ("interior", "tip")
@@ -99,20 +100,20 @@ class ContactTranscription:
         n_f = ca.vertcat(-ca.sin(psi), ca.cos(psi))
         #: (z, q) -> load point x, y, ψ; F; α; L; f; t_f·n; push = d·e/|e|; t_c (2);
         #: side = n·n_f (> 0: the object is on the finger's -y side, it pushes it to +y)
-        self.post = ca.Function(
-            f"contact_{mode}_post", [z, q],
-            [ca.vertcat(x, y, psi, force, alpha, L, level(x, y, ell), along,
-                        ca.dot(d, e) / ca.norm_2(e), t_c, ca.dot(normal, n_f)),
-             ca.mmax(ca.fabs(R))])
+        post = ca.vertcat(x, y, psi, force, alpha, L, level(x, y, ell), along,
+                          ca.dot(d, e) / ca.norm_2(e), t_c, ca.dot(normal, n_f))
+        self.post = ca.Function(f"contact_{mode}_post", [z, q], [post, ca.mmax(ca.fabs(R))])
         self.shape = ca.Function(f"contact_{mode}_shape", [z, q], beam.shape(w, P))
-        # implicit-function sensitivities: dR/dz, dR/d(cx, cy, θ, a, b), d(x_L, y_L, L)/dz
+        # implicit-function sensitivities: dR/dz, dR/d(ellipse), d(x_L, y_L, L)/dz,
+        # with post's first output (dense, for design.solve.buffers: reading a
+        # 63 x 63 DM into numpy took longer than evaluating it). Interpreted:
+        # compiled, it saved 4 % of a grasp scene's time for 2.2 s of gcc per
+        # mode on an empty cache
         tip_l = ca.vertcat(x, y, L)
-        # (dense, for design.solve.buffers: reading a 63 x 63 DM into numpy took
-        # longer than evaluating it)
         self.sensitivity = ca.Function(
             f"contact_{mode}_sens", [z, q],
             [ca.densify(ca.jacobian(R, z)), ca.densify(ca.jacobian(R, q[ELLIPSE])),
-             ca.densify(ca.jacobian(tip_l, z))])
+             ca.densify(ca.jacobian(tip_l, z)), post])
         self._continued: dict = {}
         self._newton = NewtonCache(
             f"contact_{self.mode}_newton", self.residual, "qr",
@@ -127,14 +128,23 @@ class ContactTranscription:
         return self._newton.get(tolerance, max_iter, error_on_fail, compiled_jacobian)
 
     def continued(self, tolerance: float, max_iter: int) -> ca.Function:
-        """(z0, q) -> (z, post, max |R|): :meth:`rootfinder` and :attr:`post` in
-        one call, for an integrator's many trial solves (cached)."""
+        """(z0, q) -> (z, post, max |R|): undamped Newton from z0 (CasADi's
+        ``fast_newton``, stopping at max |R| ≤ ``tolerance`` or after
+        ``max_iter`` iterations) and :attr:`post` in one function, compiled
+        to C where a compiler is (design/solve/compiled.py), for an
+        integrator's many trial solves from a nearby solution (cached). No
+        line search: the caller checks the residual and falls back to the
+        damped, stepped solve."""
         key = (tolerance, max_iter)
         if key not in self._continued:
             z0, q = ca.MX.sym("z0", self.n_z), ca.MX.sym("q", self.n_q)
-            z = self.rootfinder(tolerance, max_iter)(z0, q)
-            self._continued[key] = ca.Function(
-                f"contact_{self.mode}_{self.ellipse}_continued", [z0, q], [z, *self.post(z, q)])
+            newton = ca.rootfinder(f"contact_{self.mode}_{self.ellipse}_fast_newton",
+                                   "fast_newton", self.residual,
+                                   {"abstol": tolerance, "max_iter": max_iter})
+            z = newton(z0, q)
+            f = ca.Function(f"contact_{self.mode}_{self.ellipse}_continued", [z0, q],
+                            [z, *self.post(z, q)])
+            self._continued[key] = compiled([f]).functions[0]
         return self._continued[key]
 
     def parameters(self, length: float, ei_ref: float, ellipse: Ellipse, tau_mu: float,

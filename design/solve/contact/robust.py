@@ -52,7 +52,7 @@ from design.physics.contact import (SIDES, ContactSolution, FingerPose, Motion, 
 from design.physics.ellipse import Ellipse, rotation
 from design.solve.beam.collocation import adapted_widths
 from design.solve.contact.equations import MODES, contact_transcription
-from design.solve.buffers import evaluate
+from design.solve.buffers import Buffered
 from design.solve.newton import implicit_rate
 
 #: |penetration| below this (m) is rounding, not a second contact
@@ -293,6 +293,20 @@ class RobustContact:
         return {m: contact_transcription(self.finger.stiffness, self.intervals, self.degree, m,
                                          "conic") for m in MODES}
 
+    @cached_property
+    def _continued(self) -> dict:
+        """:meth:`ContactTranscription.continued` per mode, called through this
+        contact's own buffers (the function is shared by fingers, the
+        buffers are not)."""
+        return {m: Buffered(tr.continued(self.tolerance, MAX_STEP_ITERATIONS))
+                for m, tr in self._conic.items()}
+
+    @cached_property
+    def _sensitivity(self) -> dict:
+        """:attr:`ContactTranscription.sensitivity` per mode, through this
+        contact's own buffers."""
+        return {m: Buffered(tr.sensitivity) for m, tr in self.tr.items()}
+
     def continue_trial(self, previous: _State, center: np.ndarray, B: np.ndarray):
         """An integrator's trial evaluation: the contact at a new section of the
         object, the conic (u - c)ᵀ B (u - c) = 1 in the finger frame, by one
@@ -308,8 +322,7 @@ class RobustContact:
         q = np.concatenate([[length, self.ei_ref, center[0], center[1], B[0, 0], B[0, 1],
                              B[1, 1], previous.tau_mu], self.widths,
                             self.finger.stiffness.params])
-        solve = self._conic[mode].continued(self.tolerance, MAX_STEP_ITERATIONS)
-        z, post, resid = (np.asarray(v).ravel() for v in solve(previous.z, q))
+        z, post, resid = (v.ravel() for v in self._continued[mode](previous.z, q))
         if not resid[0] <= self.tolerance or post[3] < 0 or previous.side * post[11] <= 0 \
                 or self._check(mode, post) != "ok":
             return None
@@ -593,8 +606,8 @@ class RobustContact:
         tr = self.tr[state.mode]
         q = tr.parameters(self.finger.length, self.ei_ref, state.ellipse, state.tau_mu,
                           self.widths, self.finger.stiffness)
-        jz, jq, jtip = evaluate(tr.sensitivity, state.z, q)
-        post, _ = (np.asarray(v).ravel() for v in tr.post(state.z, q))
+        jz, jq, jtip, post = self._sensitivity[state.mode](state.z, q)
+        post = post.ravel()
         point = post[:2]
         q_dot, v_object = kin(point)
         z_dot = implicit_rate(jz, -jq @ q_dot)
