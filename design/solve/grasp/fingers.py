@@ -290,9 +290,10 @@ class FingerForces:
         self.skipped = 0           # finger evaluations the reach windows saved
         self._memo: dict = {}      # trial evaluations since the last commit
         self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
-        self._frames: dict = {}    # (finger, t) -> its frame, for the latest times
-        self._turns: dict = {}     # t -> the drum's turning since t = 0
-        self._start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
+        self._frames: dict = {}    # t -> every finger's frame, for the latest times
+        start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
+        self._base0 = np.array([base for base, _ in start])
+        self._R0 = np.array([R for _, R in start])
         self._lengths = np.array([gf.finger.length for gf in grasper.fingers])
         # every window's start, end and finger, for a vectorised test
         spans = [(a, b, i) for i, w in enumerate(windows or []) for a, b in w]
@@ -300,27 +301,27 @@ class FingerForces:
             np.array([a for a, _, _ in spans], float), np.array([b for _, b, _ in spans], float),
             np.array([i for _, _, i in spans], int))
 
-    def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Finger i's (base, R) at time t: its frame at t = 0 turned with the
-        drum. An evaluation asks for the same frames several times (contact,
-        rates at t + RATE_STEP, shares); the arrays are shared, hence
-        read-only."""
-        key = (i, t)
-        out = self._frames.get(key)
+    def frames(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Every finger's base (n, 3) and rotation (n, 3, 3) at time t: their
+        frames at t = 0 turned with the drum. An evaluation asks for the same
+        time several times (reach, contact, rates at t + RATE_STEP, shares);
+        the arrays are shared, hence read-only."""
+        out = self._frames.get(t)
         if out is None:
-            if len(self._frames) > 64 * len(self.models):
+            if len(self._frames) > 64:
                 self._frames.clear()
-                self._turns.clear()
-            turn = self._turns.get(t)
-            if turn is None:
-                turn = self._turns[t] = self.drum.turning(t)
-            base0, R0 = self._start[i]
+            turn = self.drum.turning(t)
             origin = self.drum.origin
-            out = (origin + turn @ (base0 - origin), turn @ R0)
+            out = (origin + (self._base0 - origin) @ turn.T, turn @ self._R0)
             for a in out:
                 a.setflags(write=False)
-            self._frames[key] = out
+            self._frames[t] = out
         return out
+
+    def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Finger i's (base, R) at time t (:meth:`frames`)."""
+        bases, rotations = self.frames(t)
+        return bases[i], rotations[i]
 
     def reaching(self, t: float, body: Ellipsoid) -> set[int]:
         """The fingers whose straight line enters the bird at time t (level ≤
@@ -334,9 +335,9 @@ class FingerForces:
         self.skipped += len(self.models) - inside.size
         if inside.size == 0:
             return set()
-        frames = [self.frame(i, t) for i in inside]
-        level = straight_level(body, np.array([b for b, _ in frames]),
-                               np.array([R[:, 0] for _, R in frames]), self._lengths[inside])
+        bases, rotations = self.frames(t)
+        level = straight_level(body, bases[inside], rotations[inside, :, 0],
+                               self._lengths[inside])
         return set(inside[level <= MISSES].tolist())
 
     def ellipsoid(self, y: np.ndarray) -> Ellipsoid:
