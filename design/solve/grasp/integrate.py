@@ -262,9 +262,24 @@ def _keep(grasp: Grasp, traj: Trajectory, record: Record) -> bool:
     return False
 
 
+class _Found(Exception):
+    """A time inside the band :func:`_locate` accepts, ending brentq early."""
+
+    def __init__(self, t: float):
+        super().__init__(t)
+        self.t = t
+
+
 def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
     """Where g(t) = f(t, dense(t)) crosses zero in [t_old, t_new]: the first
     time found with g ≤ -depth just past the crossing.
+
+    With ``depth`` > 0, any time where -2 depth ≤ g ≤ -depth is taken as soon
+    as it is found: past the crossing by at most depth / |g'| (a reversal
+    margin's slope is of order 1 m/s², so about 1e-9 s), and without the
+    evaluations brentq spends narrowing its bracket to 1e-12 s around a
+    function whose values near zero are Newton-tolerance noise (measured:
+    11 evaluations per reversal against 6-9).
 
     Finger forces are continued from the latest solution, so g at the
     dense-output points may differ from the step's end values by the Newton
@@ -276,7 +291,17 @@ def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
         return t_old
     if g_hi > -depth:
         return t_new
-    tau, dt = brentq(lambda tt: g(tt) + depth, t_old, t_new, xtol=1e-12), 1e-12
+
+    def shifted(tt):
+        value = g(tt) + depth
+        if depth > 0 and -depth <= value <= 0:
+            raise _Found(tt)
+        return value
+
+    try:
+        tau, dt = brentq(shifted, t_old, t_new, xtol=1e-12), 1e-12
+    except _Found as found:
+        return found.t
     # brentq's answer lies within xtol of the crossing, on either side
     while tau < t_new and g(tau) > -depth:
         tau, dt = min(tau + dt, t_new), 2 * dt
