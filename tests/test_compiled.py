@@ -224,3 +224,28 @@ def test_finger_batch_is_the_stages_one_by_one(monkeypatch):
                            rtol=1e-12, atol=1e-12 * np.abs(expected).max())
         others = [c for c in range(9) if c // 3 != n]
         assert not np.any(J[np.ix_(rows, others)])
+
+
+def test_buffered_calls_equal_the_function_s_and_do_not_share_outputs():
+    """design.solve.buffers.Buffered: the same numbers as Function.__call__
+    (column-major matrices), fresh arrays per call (a state kept from one
+    call must not change at the next), a sparse output and a wrong input
+    size named."""
+    from design.solve.buffers import Buffered
+    sparse = small_function()
+    with pytest.raises(ValueError, match="small: output 1 is sparse"):
+        Buffered(sparse)
+    X, P = ca.SX.sym("x", 3), ca.SX.sym("p", 2)
+    y, J = sparse(X, P)
+    f = ca.Function("dense", [X, P], [y, ca.densify(J)])
+    call = Buffered(f)
+    rng = np.random.default_rng(2)
+    x1, x2, p = rng.normal(size=3), rng.normal(size=3), rng.normal(size=2)
+    y1, J1 = call(x1, p)
+    y2, J2 = call(x2, p)
+    for (y, J), x in (((y1, J1), x1), ((y2, J2), x2)):
+        want_y, want_J = f(x, p)
+        assert np.array_equal(y, np.asarray(want_y)) and np.array_equal(J, np.asarray(want_J))
+    assert not np.array_equal(y1, y2)
+    with pytest.raises(ValueError, match="input 0 has 2 values, needs 3"):
+        call(x1[:2], p)

@@ -139,3 +139,27 @@ def test_the_belt_never_pulls_and_rise_and_clearance_are_told_apart(hard):
            for r in hard.trajectory.records]
     assert s["belt_clearance_m"] == pytest.approx(max(gap), abs=1e-12)
     assert s["max_pitch_rad"] > 0.05 and s["belt_clearance_m"] != s["centre_rise_m"]
+
+
+def test_a_reversal_is_located_just_past_its_crossing_in_few_evaluations():
+    """integrate._locate with a depth (friction reversals): the time returned
+    has -2 depth <= g <= -depth, so it lies past the crossing by depth/|g'|
+    to 2 depth/|g'|, and it comes from fewer evaluations than narrowing
+    brentq's bracket to 1e-12 s (on a smooth margin, with 1e-11 noise as the
+    Newton tolerance leaves on it)."""
+    from design.solve.grasp.integrate import REVERSAL_DEPTH, _locate
+    rng = np.random.default_rng(3)
+    calls = []
+
+    def margin(t, y):
+        calls.append(t)
+        return 0.012 - 3.0 * t + 40.0 * t ** 2 + 1e-11 * rng.uniform(-1, 1)
+
+    crossing = (3.0 - np.sqrt(9.0 - 4 * 40.0 * 0.012)) / 80.0
+    t = _locate(margin, lambda tt: np.zeros(6), 0.0, 0.009, REVERSAL_DEPTH)
+    slope = 3.0 - 80.0 * crossing
+    assert 0.5 * REVERSAL_DEPTH / slope <= t - crossing <= 2.5 * REVERSAL_DEPTH / slope
+    assert len(calls) <= 9
+    calls.clear()
+    exact = _locate(margin, lambda tt: np.zeros(6), 0.0, 0.009)   # an event: to 1e-12 s
+    assert abs(exact - crossing) < 1e-11 and len(calls) > 9
