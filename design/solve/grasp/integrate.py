@@ -275,11 +275,11 @@ def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
     time found with g ≤ -depth just past the crossing.
 
     With ``depth`` > 0, any time where -2 depth ≤ g ≤ -depth is taken as soon
-    as it is found: past the crossing by at most depth / |g'| (a reversal
-    margin's slope is of order 1 m/s², so about 1e-9 s), and without the
-    evaluations brentq spends narrowing its bracket to 1e-12 s around a
-    function whose values near zero are Newton-tolerance noise (measured:
-    11 evaluations per reversal against 6-9).
+    as it is found: past the crossing by depth / |g'| to 2 depth / |g'| (a
+    reversal margin's slope is of order 1 m/s², so 1e-9 to 2e-9 s), without
+    the evaluations brentq spends narrowing its bracket to 1e-12 s around a
+    function whose values near zero are Newton-tolerance noise (measured on
+    the grasp benchmark's 10 reversals: 82 evaluations against 100).
 
     Finger forces are continued from the latest solution, so g at the
     dense-output points may differ from the step's end values by the Newton
