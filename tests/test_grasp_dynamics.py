@@ -1,12 +1,14 @@
 """The bird on the belt: modes, events and impacts against closed forms."""
 
+import math
+
 import numpy as np
 import pytest
 
 from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
 from design.solve.grasp.fingers import FingerForces
-from design.solve.grasp.integrate import Grasp, IntegratorSettings, integrate
+from design.solve.grasp.integrate import Grasp, IntegratorSettings, _local_error, integrate
 
 MEAN = Bird(0.097, 0.066, 0.057, 1.8, 0.00417, "mean")
 FOOTBALL = Bird(0.122, 0.066, 0.066, 0.425, 0.0016, "football")
@@ -157,3 +159,49 @@ def test_a_belt_that_would_pull_the_bird_down_fails_the_run(monkeypatch):
     assert run.records[-1].normal == pytest.approx(-2 * MEAN.mass * G)
     assert all(r.normal >= 0 for r in run.records[:-1])
     assert run.records[-1].y[0] > -0.35 > run.records[-2].y[0]
+
+
+@pytest.mark.parametrize("k", [1, 2, 3, 4])
+@pytest.mark.parametrize("h", [1e-3, 1e-2])
+def test_local_error_estimate_is_milne_s_on_polynomials(k, h):
+    """The BDF step's error estimate |z - p| / (k + 2), p the degree-k
+    extrapolation of the last k + 1 positions: zero for motions of degree up
+    to k, and for X = t^(k+1) the extrapolation misses by (k+1)! h^(k+1)
+    exactly (the interpolation remainder), so the estimate is that over k + 2."""
+    times = h * np.arange(k + 2)
+
+    def state(x_of_t, t):
+        return np.array([x_of_t(t), 0.05 - 0.3 * t, 0.0, 0.0, 0.0, 0.0])
+
+    for degree in range(k + 2):
+        x = lambda t, d=degree: (t + 0.2) ** d     # noqa: E731
+        history = [state(x, t) for t in times[:-1]]
+        error = _local_error(history, k, state(x, times[-1]))
+        if degree <= k:
+            assert error < 1e-12
+        else:
+            expected = math.factorial(k + 1) * h ** (k + 1) / (k + 2)
+            assert error == pytest.approx(expected, rel=1e-6)
+
+
+def test_bdf4_run_fails_where_a_step_s_local_error_is_too_large(monkeypatch):
+    """The thesis's BDF-4 has no error control: a step whose estimated local
+    error exceeds max_local_error ends the run, not ok, saying when. A push of
+    1e4 m/s² switched on past X = -0.35 m (the bird riding the belt reaches it
+    in the step from t = 0.10 s) moves it 0.5 m in one 10 ms step."""
+    grasp = bare()
+    y0 = np.array([-0.4, MEAN.gamma, 0.0, 0.457, 0.0, 0.0])
+    settings = IntegratorSettings(integrator="bdf4", step=0.01)
+    calm = integrate(grasp, y0, 0.3, settings)
+    assert calm.ok and calm.local_error[0] < settings.max_local_error
+    accelerations = grasp.dyn.accelerations
+
+    def pushed(z, *args):
+        acc, normal, friction = accelerations(z, *args)
+        return acc + np.array([1e4 if z[0] > -0.35 else 0.0, 0.0, 0.0]), normal, friction
+
+    monkeypatch.setattr(grasp.dyn, "accelerations", pushed)
+    run = integrate(grasp, y0, 0.3, settings)
+    assert not run.ok and run.message.startswith("BDF-4 step from t = 0.1000 s: estimated local")
+    assert run.records[-1].t == pytest.approx(0.1)
+    assert run.local_error[0] > settings.max_local_error

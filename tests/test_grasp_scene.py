@@ -41,6 +41,8 @@ def test_finger_models_override_a_group():
      "no finger of the grasper"),
     ({"bird": "models/birds/ostrich.yaml"}, "bird", "ostrich.yaml' not found"),
     ({"solver": {"integrator": "euler"}}, "solver.integrator", "adaptive, bdf4"),
+    ({"solver": {"integrator": "bdf4", "max_local_error": "0 m"}}, "solver.max_local_error",
+     "(0, 1]"),
     ({"bird": {"semi_axes": [0.1, 0.06], "mass": 1}}, "bird.semi_axes", "expected a list of 3"),
     ({"duration": 0}, "duration", "(0, 60]"),
 ])

@@ -205,7 +205,8 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
         return GraspSettings()
     spec = reader.mapping(data[field_name], field_name,
                           optional=("integrator", "rtol", "atol", "max_step", "stepper", "step",
-                                    "contact_nodes", "reach_filter", "max_wall_time"))
+                                    "contact_nodes", "reach_filter", "max_wall_time",
+                                    "max_local_error"))
     if spec is None:
         return None
     d = IntegratorSettings()
@@ -217,15 +218,17 @@ def read_grasp_settings(reader: Reader, data: dict, field_name: str) -> GraspSet
                                default=d.max_step)
     stepper = reader.choice(spec, "stepper", field_name, STEPPERS, default=d.stepper)
     step = reader.quantity(spec, "step", field_name, "time", lo=1e-5, hi=0.1, default=d.step)
+    local = reader.quantity(spec, "max_local_error", field_name, "length", lo=0.0, lo_open=True,
+                            hi=1.0, default=d.max_local_error)
     nodes = reader.integer(spec, "contact_nodes", field_name, lo=2, hi=64, default=6)
     reach = reader.boolean(spec, "reach_filter", field_name, default=True)
     budget = reader.quantity(spec, "max_wall_time", field_name, "time", lo=0.0, lo_open=True,
                              default=None) if "max_wall_time" in spec else None
-    if None in (integ, rtol, atol, max_step, stepper, step, nodes, reach) or \
+    if None in (integ, rtol, atol, max_step, stepper, step, local, nodes, reach) or \
             ("max_wall_time" in spec and budget is None):
         return None
-    return GraspSettings(IntegratorSettings(integ, rtol, atol, max_step, stepper, step, budget),
-                         nodes, reach)
+    return GraspSettings(IntegratorSettings(integ, rtol, atol, max_step, stepper, step, budget,
+                                            local), nodes, reach)
 
 
 MOUNT_FIELDS = ("angle", "phi_x", "phi_y")

@@ -6,6 +6,7 @@ import yaml
 
 from design.io.grasp_scene import GraspSettings
 from design.physics.beam import Finger
+from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import GraspSetup
 
 
@@ -59,7 +60,9 @@ def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, descriptio
                    "max_step": i.max_step, "stepper": i.stepper, "step": i.step,
                    "contact_nodes": settings.contact_nodes,
                    "reach_filter": settings.reach_filter,
-                   **({"max_wall_time": i.max_wall_time} if i.max_wall_time else {})},
+                   **({"max_wall_time": i.max_wall_time} if i.max_wall_time else {}),
+                   **({"max_local_error": i.max_local_error}
+                      if i.max_local_error != IntegratorSettings.max_local_error else {})},
     }
 
 

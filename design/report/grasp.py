@@ -21,6 +21,9 @@ def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
             ("lowest point above the belt", s["belt_clearance_m"], "m"),
             ("least belt normal force", s["min_normal_force_N"], "N"),
             ("largest pitch", abs(s["max_pitch_rad"]), "rad")]
+    if s["local_error_estimate"] is not None:
+        rows.append(("largest estimated local error of a BDF-4 step (position)",
+                     s["local_error_estimate"]["position_m"], "m"))
     return [{"quantity": q, **({"run": label} if label else {}), "value": v, "unit": u}
             for q, v, u in rows]
 

@@ -61,6 +61,7 @@ def result_dict(scene: GraspScene, r: GraspRun) -> dict:
         "duration": scene.duration,
         "solver": {"integrator": i.integrator, "rtol": i.rtol, "atol": i.atol,
                    "max_step": i.max_step, "stepper": i.stepper, "step": i.step,
+                   "max_local_error": i.max_local_error,
                    "contact_nodes": scene.settings.contact_nodes,
                    "reach_filter": scene.settings.reach_filter},
         "summary": r.summary,

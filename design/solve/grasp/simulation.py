@@ -157,6 +157,10 @@ def summarise(run: GraspRun) -> dict:
         "finger_model": run.setup.finger_model,
         "validity": validity,
         "events": [[t, name] for t, name in run.trajectory.events],
+        # fixed-step (bdf4) runs only: the adaptive integrator controls its error
+        "local_error_estimate": None if run.trajectory.local_error is None else {
+            "position_m": run.trajectory.local_error[0],
+            "time_s": run.trajectory.local_error[1]},
         "ok": run.trajectory.ok,
         "message": run.trajectory.message,
     }
