@@ -11,6 +11,7 @@ the order of", "around": 30 %). SI: m, N, s, rad.
 
 from __future__ import annotations
 
+from dataclasses import replace
 
 import numpy as np
 
@@ -30,6 +31,9 @@ PLANAR_HARD, PLANAR_SOFT = (f"{HARD}, planar model", f"{SOFT}, planar model")
 #: Table 5-3's start as printed: the bird placed at X0 = -0.075 m at t = 0
 PLACED = ", placed at X0 = -0.075 m at t = 0"
 SOFT_PLACED, CONSTANT_PLACED = SOFT + PLACED, CONSTANT + PLACED
+#: the soft case with the finger friction off (the belt's kept): how much of
+#: the peak the drums' sweep friction makes
+SOFT_FRICTIONLESS = f"{SOFT}, frictionless fingers"
 FOOTBALL = "football (Table 5-4), µ = 1.16"
 FOOTBALL_LITERAL = f"{FOOTBALL}, Table 5-1's angles at t = 0"
 FOOTBALL_PRINTED = f"{FOOTBALL}, fingers 1 and 2 at Table 5-1's tilt"
@@ -62,6 +66,7 @@ def setups() -> dict:
            PLANAR_HARD: mean_bird_setup("hard", "planar"),
            PLANAR_SOFT: mean_bird_setup("soft", "planar"),
            SOFT_PLACED: mean_bird_setup("soft", arriving=False),
+           SOFT_FRICTIONLESS: replace(mean_bird_setup("soft"), finger_friction=0.0),
            CONSTANT_PLACED: mean_bird_setup("constant", arriving=False),
            FOOTBALL: football_setup(),
            FOOTBALL_LITERAL: football_setup(phased=False),
@@ -112,6 +117,15 @@ def z_max(run: GraspRun) -> float:
 def family(run: GraspRun, name: str) -> str:
     """The designed finger (Table 5-1's number) of a mounted finger name."""
     return next(gf.design_name for gf in run.setup.grasper.fingers if gf.name == name)
+
+
+def family_peaks(run: GraspRun) -> dict[str, float]:
+    """Largest force (N) of each designed finger (Table 5-1's number) over its sets."""
+    out: dict[str, float] = {}
+    for name, force in run.summary["max_force_per_finger_N"].items():
+        key = family(run, name)
+        out[key] = max(out.get(key, 0.0), float(force))
+    return dict(sorted(out.items()))
 
 
 def touched(run: GraspRun) -> set[str]:
@@ -171,6 +185,18 @@ def peak_split(run: GraspRun) -> str:
             f"{friction:.1f} N of friction along the surface")
 
 
+def sweep_friction(frictionless: GraspRun) -> str:
+    """What the finger friction adds: the same run with frictionless fingers."""
+    peaks = family_peaks(frictionless)
+    share = impulse_share(frictionless, lambda r: abs(r.y[0]) <= DENSE)
+    return (f" The drums sweep the fingers across the bird's surface, so each touching finger "
+            f"slides and carries µ_f times its normal force as friction; with frictionless "
+            f"fingers (the belt's friction kept) the peak is "
+            f"{_peak(frictionless)}, finger 4's {peaks.get('4', 0.0):.1f} N, and {share:.0%} "
+            f"of the force-time integral falls within ±1.5 in "
+            f"(examples/validation/friction_sensitivity.py).")
+
+
 def _peak(run: GraspRun) -> str:
     s = run.summary
     return f"{s['max_finger_force_N']:.1f} N at finger {s['max_finger_force_finger']}"
@@ -179,7 +205,7 @@ def _peak(run: GraspRun) -> str:
 def mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
     return unfinished(lambda: _mean_bird_rows(runs), runs,
                       [HARD, SOFT, CONSTANT, PLANAR_HARD, PLANAR_SOFT, SOFT_PLACED,
-                       CONSTANT_PLACED],
+                       CONSTANT_PLACED, SOFT_FRICTIONLESS],
                       "Figure 5-7, mean bird (Table 5-3)", "fingers and forces",
                       "fingers 1, 2, 4, 5; finger 4 about 11 N")
 
@@ -203,7 +229,8 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
             compare(case, f"peak finger force, {label}", "N", PEAK_MEAN, s["max_finger_force_N"],
                     READING_REL * PEAK_MEAN, "'In the order of 11N' (two sides x 11 N is about "
                     f"the bird's 17.7 N weight); tolerance 30 % for a reading. Ours: "
-                    f"{peak_split(run)}."),
+                    f"{peak_split(run)}." + (sweep_friction(runs[SOFT_FRICTIONLESS])
+                                             if name == SOFT else "")),
             claim(case, f"share of the finger force-time integral while |X| <= 38.1 mm, {label}",
                   "most ('concentrate densely' from -1.5 to +1.5 in)",
                   impulse_share(run, lambda r: abs(r.y[0]) <= DENSE),
@@ -319,7 +346,8 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         compare(case, "peak finger force", "N", PEAK_FOOTBALL, fb["max_finger_force_N"],
                 READING_REL * PEAK_FOOTBALL, "§5.3's estimate from the ball's inertia, 8.52 N, "
                 "which it calls close to the simulation's largest finger force; tolerance 30 %. "
-                f"Ours: {peak_split(run)}."),
+                f"Ours: {peak_split(run)}. At finger µ = 0.4 (Figure 5-17's run from -0.381 m) "
+                f"the peak is {_peak(runs[far[0.4]])}."),
         compare(case, "largest upward force of the fingers less the ball's weight", "N",
                 PEAK_FOOTBALL, net_lift(run), READING_REL * PEAK_FOOTBALL,
                 "What §5.3's 8.52 N = m A (2π/T)² measures: the ball's largest vertical "
@@ -352,9 +380,9 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
     mount = lambda: [pushed_back(  # noqa: E731
         runs, "Figure 5-18, football from X0 = -0.381 m", "finger 3's φx",
         {f"{d:g}°": n for d, n in phi.items()}, "3")]
-    return (unfinished(experiment, runs, [FOOTBALL], case, "the experiment (rise, pitch, "
-                       "passing, peak finger and force)", "rise 18 mm, passes, finger 4 about "
-                       "8.5 N")
+    return (unfinished(experiment, runs, [FOOTBALL, far[0.4]], case, "the experiment (rise, "
+                       "pitch, passing, peak finger and force)", "rise 18 mm, passes, finger 4 "
+                       "about 8.5 N")
             + unfinished(printed, runs, [FOOTBALL_PRINTED], case, "rise with Table 5-1's "
                          "upper-finger tilt", "around 0.018 m")
             + unfinished(literal, runs, [FOOTBALL_LITERAL], case, "finger 4 with Table 5-1's "

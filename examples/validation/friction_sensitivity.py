@@ -26,7 +26,7 @@ from pathlib import Path
 from design.io.files import TOOLKIT_ROOT
 from design.reproduce.grasp import (FOOTBALL_START, football_setup, mean_bird_setup,
                                     simulate_all)
-from design.reproduce.grasp_rows import DENSE, family, impulse_share, passes, touching
+from design.reproduce.grasp_rows import DENSE, family_peaks, impulse_share, passes, touching
 
 #: (case, setup builder of µ_f, the µ_f values run; the thesis's value first)
 CASES = (
@@ -41,18 +41,9 @@ CASES = (
 )
 
 
-def per_finger(run) -> dict[str, float]:
-    """Largest force (N) of each designed finger (Table 5-1's number), both sets."""
-    out: dict[str, float] = {}
-    for name, force in run.summary["max_force_per_finger_N"].items():
-        key = family(run, name)
-        out[key] = max(out.get(key, 0.0), float(force))
-    return dict(sorted(out.items()))
-
-
 def row(case: str, mu: float, run) -> dict:
     s = run.summary
-    peaks = per_finger(run)
+    peaks = family_peaks(run)
     return {"case": case, "finger_friction": mu, "fingers_touching": touching(run),
             "peak_finger": max(peaks, key=peaks.get), "peak_force_N": max(peaks.values()),
             "finger_peaks_N": peaks,
