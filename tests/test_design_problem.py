@@ -67,6 +67,20 @@ def test_bad_problem_is_rejected_with_file_and_field(change, field, text):
         [str(p) for p in err.value.problems]
 
 
+def test_a_simulation_only_finger_model_is_refused_by_name(tmp_path):
+    """``planar-thesis`` (the thesis's friction convention) has no NLP stage:
+    a design on it is refused at the scene's finger_model, not left to fail."""
+    scene = yaml.safe_load(Path(SCENE).read_text())
+    for key in ("grasper", "bird", "conveyor"):
+        scene[key] = str(ROOT / scene[key])
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump({**scene, "finger_model": "planar-thesis"}))
+    with pytest.raises(ProblemFileError) as err:
+        design.check(problem(scene=str(path)))
+    assert [(p.field, "for simulations only" in p.message) for p in err.value.problems] == \
+        [("scene.finger_model", True)]
+
+
 def test_bad_problem_file_exits_2_and_writes_nothing(tmp_path, capsys):
     path = tmp_path / "bad.yaml"
     path.write_text(yaml.safe_dump(problem(variables={"fingers.4.angle": [1, 0],

@@ -38,6 +38,7 @@ from design.io.files import resolve
 from design.io.grasp_scene import GraspScene, read_bird
 from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
+from design.solve.optimize.finger_load import STAGE_MODELS
 from design.solve.optimize.model_check import CHECK_MODEL
 from design.solve.optimize.population import AGGREGATES
 from design.solve.optimize.transcription import NLPSettings, Rules
@@ -130,6 +131,9 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         if "population" in data else None
     multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
         else MultistartSpec()
+    if scene is not None and scene.finger_model not in STAGE_MODELS:
+        reader.add("scene.finger_model", f"'{scene.finger_model}' is for simulations only: the "
+                   f"design NLP models {' and '.join(STAGE_MODELS)} fingers")
     # the check runs the other finger model: none for a scene that is spatial already
     checks = (CHECK_MODEL, "none") if scene is None or scene.finger_model != CHECK_MODEL \
         else ("none",)

@@ -149,12 +149,14 @@ class PlanarFinger:
 
     name = "planar"
     from_committed = False
+    #: the friction's sense follows the finger's sliding (settled at accepted steps)
+    settles_friction = True
 
     def __init__(self, finger, friction: float, intervals: int, degree: int,
                  reversal_speed: float = REVERSAL_SPEED):
         self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
                                     reversal_speed=reversal_speed)
-        self.reverses = friction > 0
+        self.reverses = friction > 0 and self.settles_friction
 
     def reversal_margin(self, state, kin_factory) -> float:
         """:meth:`RobustContact.reversal_margin` of a contact state (m/s)."""
@@ -184,8 +186,8 @@ class PlanarFinger:
                 made.append(kin_factory(cut))
             return made[0](p_f)
 
-        sol, cont = self.solver.solve_frame(cut, "auto", kin, start, settle=commit,
-                                            detail=commit)
+        sol, cont = self.solver.solve_frame(cut, "auto", kin if self.settles_friction else None,
+                                            start, settle=commit, detail=commit)
         return self._world(base, R, sol, cont)
 
     @staticmethod
@@ -243,8 +245,19 @@ class SpatialFinger:
         return R @ sol.force, base + R @ sol.point, sol, cont
 
 
+class ThesisPlanarFinger(PlanarFinger):
+    """The planar finger with the thesis's chapter III friction convention:
+    friction on the finger at µ, pointing tipwards, whatever the sliding (what
+    its Algorithms I and II and Tables 3-2 to 3-5 use). For reproducing the
+    thesis's own simulations: its FEM (Table 3-6) follows friction from the
+    sliding, as ``planar`` does, and peaks 30 % higher than this convention."""
+
+    name = "planar-thesis"
+    settles_friction = False
+
+
 #: contact models by name
-FINGER_MODELS = {"planar": PlanarFinger, "spatial": SpatialFinger}
+FINGER_MODELS = {m.name: m for m in (PlanarFinger, ThesisPlanarFinger, SpatialFinger)}
 
 
 def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):

@@ -91,7 +91,7 @@ def contact_validity(run, peaks: np.ndarray, peak_times: np.ndarray) -> dict:
             "held_at_start": [{"finger": n, "force_N": f} for n, f in held],
             "fingers_through_conveyor": through,
             "normal_out_of_plane_max": worst,
-            "planar_model_valid": setup.finger_model != "planar" or worst <= PLANAR_LIMIT}
+            "planar_model_valid": setup.finger_model == "spatial" or worst <= PLANAR_LIMIT}
 
 
 def _finger_points(drum, gf, t: float, state) -> np.ndarray:
