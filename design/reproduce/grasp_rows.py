@@ -5,10 +5,10 @@ and the Table 5-1 layout as derived in docs/MODEL.md; the mean bird is also run
 with the planar model, to show what that model says and how far outside its
 validity it is, and mean bird and football with the thesis's own model (planar
 fingers with its chapter III friction convention, ``planar-thesis``), to show
-which of its statements that model makes. The thesis gives mostly trends and readings of plots; each
-becomes a claim row with the criterion it is judged by, or a numeric row
-whose tolerance is fixed by how the thesis states the number (a reading "of
-the order of", "around": 30 %). SI: m, N, s, rad.
+which of its statements that model makes. The thesis gives mostly trends and
+readings of plots; each becomes a claim row with the criterion it is judged
+by, or a numeric row whose tolerance is fixed by how the thesis states the
+number (a reading "of the order of", "around": 30 %). SI: m, N, s, rad.
 """
 
 from __future__ import annotations
