@@ -119,6 +119,8 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         if output.result.get("kind") == "design":
             print(f"FAILED: {output.result['status']}: {output.result['message']}",
                   file=sys.stderr)
+        elif output.result.get("kind") == "grasp":
+            print(f"FAILED: {output.result['summary']['message']}", file=sys.stderr)
         else:
             print("warning: not every case converged; see 'converged' and 'message' in "
                   "result.json", file=sys.stderr)

@@ -95,6 +95,7 @@ def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):
     assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1
     summary = json.loads((tmp_path / "out" / "result.json").read_text())["summary"]
     assert not summary["ok"] and "wall-time budget of 0.2 s" in summary["message"]
+    assert f"FAILED: {summary['message']}" in capsys.readouterr().err
     t_reached = float(summary["message"].split("at t = ")[1].split(" s")[0])
     assert 0.0 <= t_reached < 0.6
 
