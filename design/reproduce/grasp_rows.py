@@ -140,7 +140,7 @@ def family_peaks(run: GraspRun) -> dict[str, float]:
 
 def touched(run: GraspRun) -> set[str]:
     """Table 5-1's numbers of the fingers that touched."""
-    return {family(run, n) for n, f in run.summary["max_force_per_finger_N"].items() if f > 0}
+    return {k for k, force in family_peaks(run).items() if force > 0}
 
 
 def touching(run: GraspRun) -> str:

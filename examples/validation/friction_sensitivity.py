@@ -29,16 +29,13 @@ from design.reproduce.grasp import (FOOTBALL_START, football_setup, mean_bird_se
 from design.reproduce.grasp_rows import DENSE, family_peaks, impulse_share, passes, touching
 
 #: (case, setup builder of µ_f, the µ_f values run; the thesis's value first)
-CASES = (
-    ("mean bird, soft lower fingers", lambda mu: replace(mean_bird_setup("soft"), finger_friction=mu),
-     (0.4, 0.2, 0.0)),
-    ("mean bird, hard lower fingers", lambda mu: replace(mean_bird_setup("hard"), finger_friction=mu),
-     (0.4, 0.2, 0.0)),
-    ("mean bird, constant EI", lambda mu: replace(mean_bird_setup("constant"), finger_friction=mu),
-     (0.4, 0.2, 0.0)),
-    (f"football, X0 = {FOOTBALL_START} m", lambda mu: football_setup(FOOTBALL_START, mu),
-     (1.16, 0.4, 0.0)),
-)
+CASES = tuple(
+    (f"mean bird, {label}",
+     lambda mu, lower=lower: replace(mean_bird_setup(lower), finger_friction=mu), (0.4, 0.2, 0.0))
+    for lower, label in (("soft", "soft lower fingers"), ("hard", "hard lower fingers"),
+                         ("constant", "constant EI"))
+) + ((f"football, X0 = {FOOTBALL_START} m", lambda mu: football_setup(FOOTBALL_START, mu),
+      (1.16, 0.4, 0.0)),)
 
 
 def row(case: str, mu: float, run) -> dict:
@@ -54,7 +51,8 @@ def row(case: str, mu: float, run) -> dict:
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=TOOLKIT_ROOT / "reports" / "validation_friction")
+    parser.add_argument("--out", type=Path,
+                        default=TOOLKIT_ROOT / "reports" / "validation_friction")
     args = parser.parse_args(argv)
     rows, start = [], time.perf_counter()
     for case, build, values in CASES:
