@@ -17,7 +17,6 @@ peak forces fall with µ_f, and the finger that carries the peak changes.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from dataclasses import replace
@@ -27,6 +26,7 @@ from design.io.files import TOOLKIT_ROOT
 from design.reproduce.grasp import (FOOTBALL_START, football_setup, mean_bird_setup,
                                     simulate_all)
 from design.reproduce.grasp_rows import DENSE, family_peaks, impulse_share, passes, touching
+from study_output import write_rows
 
 #: (case, setup builder of µ_f, the µ_f values run; the thesis's value first)
 CASES = tuple(
@@ -66,14 +66,7 @@ def main(argv: list[str] | None = None) -> int:
                   f"{r['finger_peaks_N'].get('5', 0.0):5.1f} N  within ±1.5 in "
                   f"{r['share_within_1_5_in']:.2f}  rise {1e3 * r['centre_rise_m']:5.1f} mm  "
                   f"{'passes' if r['passes'] else 'does not pass'}", flush=True)
-    args.out.mkdir(parents=True, exist_ok=True)
-    path = args.out / "friction_sensitivity.json"
-    tmp = path.with_suffix(".tmp")
-    tmp.write_text(json.dumps({"units": {"force": "N", "length": "m", "time": "s"},
-                               "wall_time_s": time.perf_counter() - start, "rows": rows},
-                              indent=1))
-    tmp.replace(path)
-    print(f"wrote {path}")
+    write_rows(args.out / "friction_sensitivity.json", rows, time.perf_counter() - start)
     return 0
 
 
