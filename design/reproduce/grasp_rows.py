@@ -65,6 +65,14 @@ def football_far(label: str) -> str:
     return f"football from X0 = -0.381 m, {label}"
 
 
+#: Figure 5-17's µ = 0 read as eq. 4.40's one µ: fingers and belt frictionless
+ONE_MU = football_far("µ = 0 on fingers and belt")
+#: what examples/validation/football_phase.py measured over the whole set period
+PHASE_STUDY = ("examples/validation/football_phase.py reruns the football studies with the "
+               "drums turned through a whole set period (0° to 110° from the designed phase, "
+               "10° steps): ")
+
+
 def setups() -> dict:
     """Every chapter V run's setup, by name."""
     out = {HARD: mean_bird_setup("hard"), SOFT: mean_bird_setup("soft"),
@@ -85,6 +93,7 @@ def setups() -> dict:
                 for mu in (0.0, 0.4, 1.16)})
     out.update({football_far(f"finger 3 φx = {deg:g}°"): football_setup(SIZES_START, 1.16, deg)
                 for deg in (45.0, 70.0)})
+    out[ONE_MU] = replace(football_setup(SIZES_START, 0.0), conveyor_friction=0.0)
     out.update({f"Table 5-5: {b}": sizes_setup(b) for b in BIRDS})
     return out
 
@@ -329,11 +338,11 @@ def x_impulse(run: GraspRun, name: str | None = None) -> float:
 
 
 def pushed_back(runs: dict[str, GraspRun], case: str, what: str, named: dict[str, str],
-                finger: str | None = None) -> Row:
+                finger: str | None = None, note: str = "") -> Row:
     """The thesis's 'pushed back at the first setting, passes at the others'
     (Figures 5-17, 5-18) against the runs ``named`` {setting label: run name};
     the explanation gives the fingers' X impulse in each (of ``finger`` if
-    the setting is that finger's)."""
+    the setting is that finger's), then ``note``."""
     (first, head), *rest = named.items()
     others = " and ".join(label for label, _ in rest)
     statement = f"pushed back at {first}; passes at {others}"
@@ -344,7 +353,7 @@ def pushed_back(runs: dict[str, GraspRun], case: str, what: str, named: dict[str
                  "; ".join(f"{label}: {_motion(runs[n])}" for label, n in named.items()),
                  not passes(runs[head]) and all(passes(runs[n]) for _, n in rest),
                  f"Criterion: {first} does not pass, {others} do. Ours, {whose} X impulse "
-                 f"on the ball (both drums, < 0 pushes it back): {impulses}.")
+                 f"on the ball (both drums, < 0 pushes it back): {impulses}. {note}".rstrip())
 
 
 def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
@@ -409,10 +418,19 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         "Criterion: both pass (as above).")]
     friction = lambda: [pushed_back(  # noqa: E731
         runs, "Figure 5-17, football from X0 = -0.381 m", "friction",
-        {f"µ = {m:g}": n for m, n in far.items()})]
+        {f"µ = {m:g}": n for m, n in far.items()},
+        note=PHASE_STUDY + "the ball passes at finger µ = 0 at every phase."), claim(
+        "Figure 5-17, football from X0 = -0.381 m", "µ = 0 on fingers and belt (eq. 4.40 "
+        "writes the belt's friction with the same µ): pushed back", "pushed back",
+        _motion(runs[ONE_MU]), not passes(runs[ONE_MU]),
+        "Table 5-4 prints one µ (rubber to rubber) and eq. 4.40 the belt's friction with it, "
+        "so Figure 5-17's µ may be the belt's too; the rows above keep the belt at 1.16. "
+        f"Criterion: does not pass. {PHASE_STUDY}so read, it is pushed back at 10° and 20° "
+        "after and 10° before the designed phase, but not at it.")]
     mount = lambda: [pushed_back(  # noqa: E731
         runs, "Figure 5-18, football from X0 = -0.381 m", "finger 3's φx",
-        {f"{d:g}°": n for d, n in phi.items()}, "3")]
+        {f"{d:g}°": n for d, n in phi.items()}, "3",
+        PHASE_STUDY + "the ball passes at φx = 45° at every phase.")]
     return (unfinished(experiment, runs, [FOOTBALL, far[0.4]], case, "the experiment (rise, "
                        "pitch, passing, peak finger and force)", "rise 18 mm, passes, finger 4 "
                        "about 8.5 N")
@@ -424,7 +442,7 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
                          "rise 18 mm, passes")
             + unfinished(start, runs, [FOOTBALL, far[1.16]], "Figure 5-16, football",
                          "passes from X0 = -0.381 and -0.305 m", "both pass")
-            + unfinished(friction, runs, list(far.values()),
+            + unfinished(friction, runs, [*far.values(), ONE_MU],
                          "Figure 5-17, football from X0 = -0.381 m", "friction",
                          "pushed back at µ = 0; passes at 0.4 and 1.16")
             + unfinished(mount, runs, list(phi.values()),
