@@ -182,6 +182,13 @@ def simulate_all(setups: dict[str, GraspSetup], progress=None,
     for k, (name, setup) in enumerate(setups.items(), 1):
         if progress:
             progress(f"grasp run {k}/{len(setups)}: {name}")
-        nodes = SPATIAL_NODES if setup.finger_model == "spatial" else GraspSettings().contact_nodes
-        runs[name] = simulate_grasp(setup, IntegratorSettings(max_wall_time=budget), nodes)
+        runs[name] = simulate_grasp(setup, IntegratorSettings(max_wall_time=budget),
+                                    contact_nodes(setup))
     return runs
+
+
+def contact_nodes(setup: GraspSetup) -> int:
+    """Collocation intervals per contact the chapter V runs use: the spatial
+    rod's 3 (within 5e-6 of 10, benchmarks/spatial_mesh.py), else a grasp
+    scene's default."""
+    return SPATIAL_NODES if setup.finger_model == "spatial" else GraspSettings().contact_nodes

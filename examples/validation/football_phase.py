@@ -16,21 +16,18 @@ minutes with two workers.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 
-from design.io.files import TOOLKIT_ROOT
 from design.reproduce.grasp import (FOOTBALL_START, OMEGA, SIZES_START, advanced,
                                     football_setup, simulate_all)
 from design.reproduce.grasp_rows import (PEAK_FOOTBALL, READING_REL, RISE_FOOTBALL, back_off,
                                          family_peaks, passes, x_end)
-from study_output import write_rows
+from study_output import parser as study_parser, write_rows
 
 MODELS = ("spatial", "planar-thesis")
 PHASES = tuple(range(0, 120, 10))
@@ -83,8 +80,7 @@ def statements(rows: list[dict]) -> dict[str, bool]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=TOOLKIT_ROOT / "reports" / "validation_phase")
+    parser = study_parser(__doc__, "validation_phase")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
     start, rows = time.perf_counter(), []

@@ -18,20 +18,18 @@ the longest).
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
 import time
 from dataclasses import replace
-from pathlib import Path
 
-from design.io.files import TOOLKIT_ROOT
-from design.reproduce.grasp import FOOTBALL_START, SIZES_START, football_setup, mean_bird_setup
+from design.reproduce.grasp import (FOOTBALL_START, SIZES_START, contact_nodes, football_setup,
+                                    mean_bird_setup)
 from design.reproduce.grasp_rows import (DENSE, back_off, family_peaks, impulse_share, passes,
                                          touching, x_end, x_impulse)
 from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import SPATIAL_NODES, GraspSetup, simulate_grasp
-from study_output import write_rows
+from design.solve.grasp.simulation import GraspSetup, simulate_grasp
+from study_output import parser as study_parser, write_rows
 
 #: the thesis's integrator as it ran (design tradeoff's "bdf4 (thesis)")
 THESIS_STEP = {"football": 16.6e-3, "mean bird": 5.6e-3}
@@ -69,14 +67,11 @@ def cases():
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path,
-                        default=TOOLKIT_ROOT / "reports" / "validation_variants")
+    parser = study_parser(__doc__, "validation_variants")
     args = parser.parse_args(argv)
     rows, start = [], time.perf_counter()
     for variant, scene, setup, settings in cases():
-        nodes = SPATIAL_NODES if setup.finger_model == "spatial" else 6
-        run = simulate_grasp(setup, settings, nodes)
+        run = simulate_grasp(setup, settings, contact_nodes(setup))
         peaks = family_peaks(run)
         r = {"variant": variant, "scene": scene, "ok": bool(run.trajectory.ok),
              "message": run.summary["message"], "centre_rise_m": run.summary["centre_rise_m"],

@@ -16,17 +16,14 @@ peak forces fall with µ_f, and the finger that carries the peak changes.
 
 from __future__ import annotations
 
-import argparse
 import sys
 import time
 from dataclasses import replace
-from pathlib import Path
 
-from design.io.files import TOOLKIT_ROOT
 from design.reproduce.grasp import (FOOTBALL_START, football_setup, mean_bird_setup,
                                     simulate_all)
 from design.reproduce.grasp_rows import DENSE, family_peaks, impulse_share, passes, touching
-from study_output import write_rows
+from study_output import parser as study_parser, write_rows
 
 #: (case, setup builder of µ_f, the µ_f values run; the thesis's value first)
 CASES = tuple(
@@ -50,9 +47,7 @@ def row(case: str, mu: float, run) -> dict:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path,
-                        default=TOOLKIT_ROOT / "reports" / "validation_friction")
+    parser = study_parser(__doc__, "validation_friction")
     args = parser.parse_args(argv)
     rows, start = [], time.perf_counter()
     for case, build, values in CASES:

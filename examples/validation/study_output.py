@@ -2,8 +2,19 @@
 
 from __future__ import annotations
 
+import argparse
 import json
 from pathlib import Path
+
+from design.io.files import TOOLKIT_ROOT
+
+
+def parser(doc: str, name: str) -> argparse.ArgumentParser:
+    """A study's command line: described by its docstring's first line, with
+    ``--out DIR`` (default reports/<name>/)."""
+    p = argparse.ArgumentParser(description=doc.splitlines()[0])
+    p.add_argument("--out", type=Path, default=TOOLKIT_ROOT / "reports" / name)
+    return p
 
 
 def write_rows(path: Path, rows: list[dict], wall_time_s: float, **extra) -> None:
