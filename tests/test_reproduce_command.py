@@ -19,7 +19,8 @@ from design.physics.ellipse import Ellipse
 from design.report.page import number
 from design.reproduce.contact import CASES, THESIS_PASS, UNIFORM, pass_position, scene
 from design.reproduce.contact_rows import FEM_REL, FORCE_REL, POINT_TOL
-from design.reproduce.rows import BASES, COLUMNS, claim, compare
+from design.reproduce.rows import (BASES, COLUMNS, THESIS_MEASUREMENT, claim, compare,
+                                   tally_by_basis, verdict)
 from tests import prefetch
 from tests.closed_forms import EFFECTIVE_EI_REL, effective_ei, transverse_cantilever
 from tests.contact_reference import reference
@@ -150,7 +151,7 @@ def test_table_5_2_effective_ei(result):
 
 def test_rows_name_their_basis_and_the_counts_split_by_it(result):
     """Table 2-1's numbers are our closed form (the thesis prints none): own
-    reference; every other row is a thesis number or statement."""
+    reference; every other row is a thesis number, statement or measurement."""
     assert {r["basis"] for r in result["rows"]} <= set(BASES)
     for r in result["rows"]:
         own = r["case"] == "Table 2-1" and r["quantity"].startswith("load-point deflection y, ") \
@@ -271,6 +272,18 @@ def test_row_tolerance_and_claims():
     assert compare("c", "q", "N", 0.0, 0.1, 0.5).relative_difference is None
     c = claim("c", "q", "more", 3.0, False, "why")
     assert c.difference is None and not c.agrees and c.as_dict()["ours"] == 3.0
+
+
+def test_the_verdict_counts_each_basis_apart():
+    """What the thesis measured is counted apart from what it calculated, so
+    that the report says how the model fares against the experiment."""
+    rows = [compare("c", "q", "m", 1.0, 1.0, 0.1, basis=THESIS_MEASUREMENT),
+            claim("c", "q", "passes", "passes", True, "why", basis=THESIS_MEASUREMENT),
+            compare("c", "q", "m", 1.0, 2.0, 0.1), claim("c", "q", "more", "less", False, "why")]
+    assert tally_by_basis(rows) == {"thesis number": (0, 1), "thesis statement": (0, 1),
+                                    "thesis measurement": (2, 2)}
+    assert verdict(rows) == ("2 of 4 rows agree within their stated tolerance (thesis numbers: "
+                             "0 of 1; thesis statements: 0 of 1; thesis measurements: 2 of 2)")
 
 
 def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path, monkeypatch,

@@ -29,7 +29,8 @@ HOW_TO_READ = (
     "trend "
     "or a bound) agrees when ours bears it out by the criterion in its explanation. The "
     "'basis' column says what ours is compared with: a number the thesis prints, a statement "
-    "it makes, or, where it prints nothing, one of our own references (a closed form, a finer "
+    "it makes (both from its own calculations and simulations), what its football experiment "
+    "measured, or, where it prints nothing, one of our own references (a closed form, a finer "
     "method); no tolerance is derived from our own results. SI units: "
     "m, N, s, rad, N m^2 (the thesis's degrees converted). Disagreements are findings, not "
     "failures: their explanations say what we think causes them.")

@@ -7,8 +7,11 @@ states. Every tolerance is fixed before the comparison, from the thesis's
 printed digits or its stated accuracy, never from our own results.
 
 Each row names its ``basis``: a number the thesis prints, a statement it
-makes (a trend, a bound, a reading of a plot), or one of our own references
-standing in where the thesis prints nothing (a closed form, a finer method).
+makes (a trend, a bound, a reading of a plot), what its experiment measured
+(the football of §5.3: its rise, its attitude on video, its passing), or
+one of our own references standing in where the thesis prints nothing (a
+closed form, a finer method). Numbers and statements come from the
+thesis's own calculations and simulations; measurements do not.
 """
 
 from __future__ import annotations
@@ -20,9 +23,9 @@ from dataclasses import dataclass, field
 COLUMNS = ("case", "quantity", "basis", "unit", "thesis", "ours", "difference",
            "relative_difference", "tolerance", "agrees", "explanation")
 #: what a row compares ours with
-THESIS_NUMBER, THESIS_STATEMENT, OWN_REFERENCE = ("thesis number", "thesis statement",
-                                                  "own reference")
-BASES = (THESIS_NUMBER, THESIS_STATEMENT, OWN_REFERENCE)
+THESIS_NUMBER, THESIS_STATEMENT, THESIS_MEASUREMENT, OWN_REFERENCE = (
+    "thesis number", "thesis statement", "thesis measurement", "own reference")
+BASES = (THESIS_NUMBER, THESIS_STATEMENT, THESIS_MEASUREMENT, OWN_REFERENCE)
 
 
 class CaseFailed(RuntimeError):
