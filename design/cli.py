@@ -115,6 +115,10 @@ def cmd_simulate(args: argparse.Namespace) -> int:
         from design.run.solve import status_line
 
         print(status_line(r))
+    elif r.get("kind") == "grasp" and output.ok:
+        from design.run.grasp import summary_line
+
+        print(summary_line(r))
     if not output.ok:
         if output.result.get("kind") == "design":
             print(f"FAILED: {output.result['status']}: {output.result['message']}",

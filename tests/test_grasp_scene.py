@@ -82,6 +82,30 @@ def test_mounts_change_every_set_of_a_finger():
     assert any(p.field == "mounts.9" and "no finger '9'" in p.message for p in err.value.problems)
 
 
+def test_a_finished_run_closes_with_its_numbers_and_its_validity(tmp_path, capsys):
+    """The closing line gives the summary's hold and peak, and says
+    'outside its validity' exactly when the summary lists a problem."""
+    from design.run.grasp import summary_line
+
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
+                                    "bird": str(ROOT / SCENE["bird"])}))
+    assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 0
+    result = json.loads((tmp_path / "out" / "result.json").read_text())
+    last = capsys.readouterr().out.strip().splitlines()[-1]
+    assert last == summary_line(result)
+    assert last.startswith("finished: hold 0.0000 s") and "no finger touched the bird" in last
+    s = result["summary"]
+    held = {**s, "hold_time_s": 0.25, "max_finger_force_N": 31.5, "max_finger_force_finger": "4a",
+            "max_finger_force_time_s": 0.2,
+            "validity": {**s["validity"], "fingers_through_conveyor": [
+                {"finger": "5b", "time_s": 0.3, "depth_m": 0.0074}]}}
+    line = summary_line({**result, "summary": held})
+    assert line.startswith("finished (by a model outside its validity): hold 0.2500 s")
+    assert "peak finger force 31.50 N at 4a (t = 0.200 s)" in line
+    assert line.endswith("finger 5b passed 7.4 mm through the belt under the bird at 0.300 s")
+
+
 def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):
     """`solver: {max_wall_time: ...}`: the run stops, exit 1, `ok` false, and
     the message says where it got to; the records so far are kept."""
