@@ -67,10 +67,9 @@ BASE_PASSED = "the contact reached the finger's base on the way (the object pass
 SIDE_NAMES = {side: name for name, side in SIDES.items()}
 #: sliding speeds below this (m/s) count as sticking
 STICK_SPEED = 1e-7
-#: Newton iterations per solve: a start inside the convergence region needs 3-6
-MAX_NEWTON_ITERATIONS = 20
-#: a continuation step whose Newton solve needs more iterations than this is
-#: halved: it started too far from the continued solution
+#: Newton iterations a solve may take (a start inside the convergence region
+#: needs 3-6): a continuation step that needs more started too far from the
+#: continued solution and is halved, so iterating on is wasted
 MAX_STEP_ITERATIONS = 12
 
 
@@ -481,7 +480,7 @@ class RobustContact:
         tr = self.tr[mode]
         q = tr.parameters(self.finger.length, self.ei_ref, ell, tau_mu, self.widths,
                           self.finger.stiffness)
-        rf = tr.rootfinder(self.tolerance, MAX_NEWTON_ITERATIONS)
+        rf = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)
         z = np.asarray(rf(z0, q)).ravel()
         self._last_iterations = int(rf.stats().get("iter_count", 0))
         self.newton_iterations += self._last_iterations

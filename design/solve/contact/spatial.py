@@ -41,8 +41,10 @@ from design.solve.newton import implicit_rate
 #: the straight finger enters the object over less than grazing_shift's grid
 #: resolves (l / 200): a touch without force, not a failure
 GRAZES = "the straight finger only grazes the object"
-#: Newton iterations per solve, and the most a continuation step may take
-MAX_NEWTON_ITERATIONS, MAX_STEP_ITERATIONS = 20, 12
+#: Newton iterations a solve may take: a step that needs more jumped branch or
+#: stalled (at a fold, where the friction drags the contact off), and is
+#: retried shorter, so iterating on is wasted
+MAX_STEP_ITERATIONS = 12
 #: residual (dimensionless) below which a Newton solve counts as converged
 RESIDUAL_TOL = 1e-8
 
@@ -391,7 +393,7 @@ class SpatialContact:
     def _newton(self, mode, z0, quadric, friction):
         tr = self.tr[mode]
         q = self._params(quadric, friction)
-        rf = tr.rootfinder(self.tolerance, MAX_NEWTON_ITERATIONS)
+        rf = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)
         z = np.asarray(rf(z0, q)).ravel()
         stats = rf.stats()
         self._last_iterations = int(stats.get("iter_count", 0))
