@@ -67,9 +67,10 @@ BASE_PASSED = "the contact reached the finger's base on the way (the object pass
 SIDE_NAMES = {side: name for name, side in SIDES.items()}
 #: sliding speeds below this (m/s) count as sticking
 STICK_SPEED = 1e-7
-#: Newton iterations a solve may take (a start inside the convergence region
-#: needs 3-6): a continuation step that needs more started too far from the
-#: continued solution and is halved, so iterating on is wasted
+#: Newton iterations a solve may take (planar and spatial contacts; a start
+#: inside the convergence region needs 3-6): a continuation step that needs
+#: more started too far from the continued solution, or stalled at a fold, and
+#: is halved, so iterating on is wasted
 MAX_STEP_ITERATIONS = 12
 
 

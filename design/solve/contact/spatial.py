@@ -33,7 +33,8 @@ from design.physics.beam import Finger
 from design.solve.beam.collocation import adapted_widths
 from design.physics.beam import PointLoad, straight_solution
 from design.solve.beam.rod import RodStiffness
-from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, PENETRATION_TOL, follow
+from design.solve.contact.robust import (BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS,
+                                         PENETRATION_TOL, follow)
 from design.solve.contact.spatial_equations import MODES, spatial_transcription
 from design.solve.buffers import evaluate
 from design.solve.newton import implicit_rate
@@ -41,10 +42,6 @@ from design.solve.newton import implicit_rate
 #: the straight finger enters the object over less than grazing_shift's grid
 #: resolves (l / 200): a touch without force, not a failure
 GRAZES = "the straight finger only grazes the object"
-#: Newton iterations a solve may take: a step that needs more jumped branch or
-#: stalled (at a fold, where the friction drags the contact off), and is
-#: retried shorter, so iterating on is wasted
-MAX_STEP_ITERATIONS = 12
 #: residual (dimensionless) below which a Newton solve counts as converged
 RESIDUAL_TOL = 1e-8
 
