@@ -147,6 +147,18 @@ def family_peaks(run: GraspRun) -> dict[str, float]:
     return dict(sorted(out.items()))
 
 
+def near_reading(value: float, reading: float) -> bool:
+    """Within READING_REL of a number the thesis gives as a reading."""
+    return abs(value - reading) <= READING_REL * reading
+
+
+def meets_figure_5_7(run: GraspRun) -> bool:
+    """Figure 5-7's mean bird: fingers 1, 2, 4, 5 touch and the peak is finger
+    4's, about 11 N."""
+    return touching(run) == "1, 2, 4, 5" and peak_family(run) == "4" \
+        and near_reading(run.summary["max_finger_force_N"], PEAK_MEAN)
+
+
 def touched(run: GraspRun) -> set[str]:
     """Table 5-1's numbers of the fingers that touched."""
     return {k for k, force in family_peaks(run).items() if force > 0}
@@ -266,9 +278,7 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
             "fingers 1, 2, 4, 5 touch; the peak is finger 4's, about 11 N; forces concentrate "
             "within ±1.5 in", f"fingers {touching(run)}; {_peak(run)}; {share:.0%} of the "
             f"force-time integral within ±1.5 in",
-            touching(run) == "1, 2, 4, 5" and peak_family(run) == "4"
-            and abs(run.summary["max_finger_force_N"] - PEAK_MEAN) <= READING_REL * PEAK_MEAN
-            and share > 0.5,
+            meets_figure_5_7(run) and share > 0.5,
             "The runs above let the bird arrive (one set period upstream); this one starts it "
             "where Table 5-3 prints, already held by finger 4a, as the thesis's 0.5 s run "
             "(Figure 5-5) seems to. Criterion: all three statements."))
@@ -285,9 +295,7 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
         rows.append(claim(case, f"the planar finger model on the same run ({name})",
                           "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
                           f"fingers {touching(run)}; {_peak(run)}",
-                          touching(run) == "1, 2, 4, 5" and peak_family(run) == "4"
-                          and abs(run.summary["max_finger_force_N"] - PEAK_MEAN)
-                          <= READING_REL * PEAK_MEAN,
+                          meets_figure_5_7(run),
                           "Outside its validity: " + ("; ".join(problems) or "none") +
                           ". Criterion: both statements."))
     for name in (THESIS_SOFT, THESIS_CONSTANT, THESIS_HARD):
@@ -297,8 +305,7 @@ def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
             f"convention ({name.removesuffix(OWN)})",
             "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
             f"fingers {touching(run)}; {_peak(run)}",
-            touching(run) == "1, 2, 4, 5" and peak_family(run) == "4"
-            and abs(run.summary["max_finger_force_N"] - PEAK_MEAN) <= READING_REL * PEAK_MEAN,
+            meets_figure_5_7(run),
             "Friction on each finger at µ, pointing tipwards whatever the sliding (as in "
             "Tables 3-2 to 3-5; its FEM, Table 3-6, follows the sliding instead): how the "
             "thesis computed its forces, not what our grasp runs use. Criterion: both "
@@ -401,8 +408,7 @@ def football_rows(runs: dict[str, GraspRun]) -> list[Row]:
         case, "the thesis's own model (planar fingers, its chapter III friction convention): "
         "rise about 18 mm, passes", "rise around 0.018 m, passes (Figures 5-13, 5-14)",
         _motion(own_run),
-        abs(own_run.summary["centre_rise_m"] - RISE_FOOTBALL) <= READING_REL * RISE_FOOTBALL
-        and passes(own_run),
+        near_reading(own_run.summary["centre_rise_m"], RISE_FOOTBALL) and passes(own_run),
         "The model that meets the mean bird's force statements, on the experiment. "
         "Criterion: the rise within 30 % and passing, as above.")]
     literal_run = runs[FOOTBALL_LITERAL]

@@ -25,8 +25,8 @@ import numpy as np
 
 from design.reproduce.grasp import (FOOTBALL_START, OMEGA, SIZES_START, advanced,
                                     football_setup, simulate_all)
-from design.reproduce.grasp_rows import (PEAK_FOOTBALL, READING_REL, RISE_FOOTBALL, back_off,
-                                         family_peaks, passes, x_end)
+from design.reproduce.grasp_rows import (PEAK_FOOTBALL, RISE_FOOTBALL, back_off, family_peaks,
+                                         near_reading, passes, x_end)
 from study_output import parser as study_parser, write_rows
 
 MODELS = ("spatial", "planar-thesis")
@@ -65,11 +65,10 @@ def statements(rows: list[dict]) -> dict[str, bool]:
     r = {row["case"]: row for row in rows}
     exp = r["experiment"]
     return {
-        "rise 18 mm ±30 %": abs(exp["centre_rise_m"] - RISE_FOOTBALL)
-        <= READING_REL * RISE_FOOTBALL,
+        "rise 18 mm ±30 %": near_reading(exp["centre_rise_m"], RISE_FOOTBALL),
         "passes, no turnover": exp["passes"] and exp["max_pitch_deg"] < 90.0,
         "peak finger 4, 8.5 N ±30 %": exp["peak_finger"] == "4"
-        and abs(exp["peak_force_N"] - PEAK_FOOTBALL) <= READING_REL * PEAK_FOOTBALL,
+        and near_reading(exp["peak_force_N"], PEAK_FOOTBALL),
         "Fig 5-16": exp["passes"] and r["X0 -0.381"]["passes"],
         "Fig 5-17 (fingers)": not r["finger µ 0"]["passes"] and r["finger µ 0.4"]["passes"]
         and r["X0 -0.381"]["passes"],
