@@ -103,7 +103,7 @@ def test_a_finished_run_closes_with_its_numbers_and_its_validity(tmp_path, capsy
     line = summary_line({**result, "summary": held})
     assert line.startswith("finished (by a model outside its validity): hold 0.2500 s")
     assert "peak finger force 31.50 N at 4a (t = 0.200 s)" in line
-    assert line.endswith("finger 5b passed 7.4 mm through the belt under the bird at 0.300 s")
+    assert line.endswith("finger 5b passed 7.4 mm through the belt at 0.300 s")
 
 
 def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):

@@ -11,7 +11,8 @@ birds and conveyor profiles (each inline or a file under ``models/``).
     conveyor: models/conveyors/constant_0457.yaml     # or {speed: 0.457, ...}
     drum_speed: 20 rpm
     start: {X: -0.457}                                  # centre X at t = 0 (m)
-    friction: {finger: 0.4, conveyor: 0.4}
+    friction: {finger: 0.4, conveyor: 0.4}             # and belt: finger-belt (default: conveyor)
+    belt: {width: 0.15 m, slots: ["5"]}                # optional (default: solid, no slots)
     legs: {stiffness: 30, damping: 1.5}                 # N/m, N s/m
     duration: 2.0
     solver: {integrator: adaptive}                      # adaptive | bdf4, and options
@@ -28,6 +29,7 @@ from design.io.fingers import read_finger
 from design.io.files import read_model
 from design.io.reader import Reader, join
 from design.physics.beam import Finger
+from design.physics.belt import Belt
 from design.physics.bird import Bird, Conveyor, Legs
 from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import FingerMount
@@ -255,6 +257,30 @@ def _remounted(reader: Reader, grasper: Grasper, value: object) -> Grasper:
     return grasper.remounted(changes)
 
 
+def read_belt(reader: Reader, data: dict, grasper: Grasper | None) -> Belt | None:
+    """``belt: {width: .., slots: [finger, ...]}`` (design/physics/belt.py);
+    absent: a solid belt."""
+    if "belt" not in data:
+        return Belt()
+    spec = reader.mapping(data["belt"], "belt", optional=("width", "slots"))
+    if spec is None:
+        return None
+    width = reader.quantity(spec, "width", "belt", "length", lo=0.0, lo_open=True,
+                            default=np.inf)
+    slots = spec.get("slots", [])
+    if not isinstance(slots, list):
+        reader.add(join("belt", "slots"), f"a list of finger names, not {slots!r}")
+        return None
+    names = sorted({gf.design_name for gf in grasper.fingers}) if grasper is not None else None
+    for slot in slots:
+        if names is not None and str(slot) not in names:
+            reader.add(join("belt", "slots"), f"the grasper has no finger '{slot}' (it has "
+                                              f"{', '.join(names)})")
+    if width is None or not reader.ok:
+        return None
+    return Belt(width, frozenset(str(x) for x in slots))
+
+
 def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspScene | None:
     grasper = read_grasper(reader, data["grasper"], "grasper", base_dir) \
         if "grasper" in data else None
@@ -265,11 +291,14 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
     omega = reader.quantity(data, "drum_speed", "", "angular_speed", lo=0.0, lo_open=True)
     start = reader.mapping(data["start"], "start", required=("X",)) if "start" in data else None
     x0 = reader.quantity(start, "X", "start", "length") if start is not None else None
-    fr = reader.mapping(data.get("friction", {}), "friction", optional=("finger", "conveyor"))
+    fr = reader.mapping(data.get("friction", {}), "friction",
+                        optional=("finger", "conveyor", "belt"))
     mu_f = reader.quantity(fr or {}, "finger", "friction", "dimensionless", lo=0.0, hi=10.0,
                            default=0.4)
     mu_c = reader.quantity(fr or {}, "conveyor", "friction", "dimensionless", lo=0.0, hi=10.0,
                            default=0.4)
+    mu_b = reader.quantity(fr or {}, "belt", "friction", "dimensionless", lo=0.0, hi=10.0,
+                           default=None)
     lg = reader.mapping(data.get("legs", {}), "legs", optional=("stiffness", "damping"))
     k = reader.quantity(lg or {}, "stiffness", "legs", "spring_stiffness", lo=0.0,
                         default=Legs().stiffness)
@@ -279,6 +308,7 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
     settings = read_grasp_settings(reader, data, "solver")
     if grasper is not None and "mounts" in data:
         grasper = _remounted(reader, grasper, data["mounts"])
+    belt = read_belt(reader, data, grasper)
     if grasper is not None and models:
         grasper = grasper.with_models(models)
         unknown = set(models) - {gf.group for gf in grasper.fingers}
@@ -286,7 +316,8 @@ def read_grasp(reader: Reader, data: dict, base_dir: Path, name: str) -> GraspSc
             reader.add(join("finger_models", group), f"no finger of the grasper is in group "
                                                      f"'{group}'")
     if not reader.ok or None in (grasper, bird, conveyor, omega, x0, mu_f, mu_c, k, c, duration,
-                                 settings, finger_model):
+                                 settings, finger_model, belt):
         return None
     return GraspScene(grasper, bird, conveyor, omega, x0, mu_f, mu_c, Legs(k, c), duration,
-                      finger_model, name, settings, data.get("description", ""))
+                      finger_model, belt, mu_b, name=name, settings=settings,
+                      description=data.get("description", ""))

@@ -26,7 +26,8 @@ KINDS = {
     "contact": (("finger", "drum", "finger_angle", "object", "friction"),
                 ("sliding", "motion", "solver"), read_contact),
     "grasp": (("grasper", "bird", "conveyor", "drum_speed", "start", "duration"),
-              ("finger_models", "mounts", "friction", "legs", "finger_model", "solver"), read_grasp),
+              ("finger_models", "mounts", "friction", "legs", "finger_model", "solver", "belt"),
+              read_grasp),
     "design": (("scene", "variables"), ("cap", "rules", "solver", "population",
                                              "multistart", "model_check"), read_design),
 }

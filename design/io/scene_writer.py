@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import yaml
 
 from design.io.grasp_scene import GraspSettings
@@ -52,7 +53,11 @@ def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, descriptio
         "conveyor": conveyor,
         "drum_speed": setup.drum_speed,
         "start": {"X": setup.start_x},
-        "friction": {"finger": setup.finger_friction, "conveyor": setup.conveyor_friction},
+        "friction": {"finger": setup.finger_friction, "conveyor": setup.conveyor_friction,
+                     **({} if setup.belt_friction is None else {"belt": setup.belt_friction})},
+        **({} if setup.belt.solid else {"belt": {
+            **({} if np.isinf(setup.belt.width) else {"width": setup.belt.width}),
+            **({"slots": sorted(setup.belt.slots)} if setup.belt.slots else {})}}),
         "legs": {"stiffness": setup.legs.stiffness, "damping": setup.legs.damping},
         "duration": setup.duration,
         "finger_model": setup.finger_model,

@@ -15,13 +15,18 @@ from design.solve.optimize.profile import profile_rows
 def verification_rows(result: dict) -> list[dict]:
     """Optimiser against the independent simulation, with each check's verdict."""
     v = result["verification"]
-    hold_ok = v["hold_time_relative_difference"] <= v["hold_tolerance"]
+    # a claim the optimiser could not evaluate is NaN, null in result.json: not passed
+    difference = v["hold_time_relative_difference"]
+    hold_ok = difference is not None and difference <= v["hold_tolerance"]
     force_ok = v["max_finger_force_N"] <= v["cap_N"] * (1 + v["cap_tolerance"])
     return [
-        {"check": "longest N = 0 hold (s)", "optimiser or limit": v["optimiser_hold_time_s"],
+        {"check": "longest N = 0 hold (s)",
+         "optimiser or limit": "not evaluated" if v["optimiser_hold_time_s"] is None
+         else v["optimiser_hold_time_s"],
          "independent simulation": v["hold_time_s"],
          "allowed": f"within {100 * v['hold_tolerance']:g} %",
-         "difference": v["hold_time_relative_difference"], "passed": hold_ok},
+         "difference": "not evaluated" if difference is None else difference,
+         "passed": hold_ok},
         {"check": "peak finger force (N), against the cap", "optimiser or limit": v["cap_N"],
          "independent simulation": v["max_finger_force_N"],
          "allowed": f"≤ cap + {100 * v['cap_tolerance']:g} %",

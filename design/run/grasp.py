@@ -20,8 +20,9 @@ def setup_of(scene: GraspScene) -> GraspSetup:
 
 def timeseries(run: GraspRun) -> list[dict]:
     """One row per recorded instant: bird state, belt forces, each finger's
-    force on the bird (right drum, world frame, N) and contact point on the
-    bird (bird frame, m). The left drum's fingers are the mirror images."""
+    force on the bird (right drum, world frame, N), its contact point on the
+    bird (bird frame, m) and its normal force on the belt (N). The left
+    drum's fingers are the mirror images."""
     names = [gf.name for gf in run.setup.grasper.fingers]
     rows = []
     for r in run.trajectory.records:
@@ -33,6 +34,7 @@ def timeseries(run: GraspRun) -> list[dict]:
             p = f.body_point
             row.update({f"F{n}_x_N": f.force[0], f"F{n}_y_N": f.force[1],
                         f"F{n}_z_N": f.force[2], f"F{n}_N": f.magnitude,
+                        f"B{n}_N": f.belt_force,
                         f"P{n}_x_m": None if p is None else p[0],
                         f"P{n}_y_m": None if p is None else p[1],
                         f"P{n}_z_m": None if p is None else p[2]})
@@ -59,7 +61,9 @@ def result_dict(scene: GraspScene, r: GraspRun) -> dict:
         "grasper": scene.grasper.describe(), "bird": scene.bird.describe(),
         "conveyor": scene.conveyor.describe(), "drum_speed": scene.drum_speed,
         "start_X": scene.start_x,
-        "friction": {"finger": scene.finger_friction, "conveyor": scene.conveyor_friction},
+        "friction": {"finger": scene.finger_friction, "conveyor": scene.conveyor_friction,
+                     "finger_belt": scene.finger_belt_friction},
+        "belt": scene.belt.describe(),
         "legs": {"stiffness": scene.legs.stiffness, "damping": scene.legs.damping},
         "duration": scene.duration,
         "solver": {"integrator": i.integrator, "rtol": i.rtol, "atol": i.atol,

@@ -437,9 +437,11 @@ def status_line(result: dict) -> str:
     caveat = " (by a model outside its validity)" if status == VERIFIED and \
         v["model_warnings"] else ""
     check = f"; {check_text(result['model_check'])}" if result.get("model_check") else ""
+    claimed = result["objective"]["hold_time_s"]
+    claimed = "not evaluated" if claimed is None or not np.isfinite(claimed) else \
+        f"{claimed:.4f} s"
     return (f"{status}{caveat}: hold {v['hold_time_s']:.4f} s in the independent simulation "
-            f"(optimiser {result['objective']['hold_time_s']:.4f} s; baseline "
-            f"{b['hold_time_s']:.4f} s), {peak}{check}")
+            f"(optimiser {claimed}; baseline {b['hold_time_s']:.4f} s), {peak}{check}")
 
 
 def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: Scored,
@@ -511,8 +513,8 @@ def _status(space, problem, outcome: Outcome, check, fine: Scored, variables
     if check["passed"]:
         return VERIFIED, "the independent simulation confirms the design"
     if not np.isfinite(claimed):
-        return ERROR, (f"the optimiser could not evaluate its own design ({source}), so it "
-                       f"cannot be verified{failures}")
+        return FAILED, (f"the optimiser could not evaluate its own design ({source}), so the "
+                        f"independent simulation has no claim to confirm{failures}")
     if not outcome.feasible:
         return FAILED, "infeasible: " + _diagnosis(space, problem, outcome, variables)
     return FAILED, (f"the independent simulation disagrees: hold {fine.hold:.4f} s against the "

@@ -93,22 +93,50 @@ class BeamTranscription:
         collocation point, interval by interval.
     n_p : int
         Length of the parameter vector P = [F, α, L, EI_r, h_1..h_K, p...].
+
+    A *segment* (``segment=True``) is the part of a finger from arc length s0
+    to s0 + L, clamped in its own frame at its start, under a force given by
+    its components (F_x, F_y) (N, in that frame) and a point moment at its end:
+    P = [F_x, F_y, L, EI_r, h_1..h_K, p..., s0, μ_end], μ(1) = μ_end = M L /
+    EI_r. Two segments make a finger loaded at two points
+    (design/solve/contact/planar_belt_equations.py).
     """
 
-    def __init__(self, stiffness: Stiffness, intervals: int, degree: int = 4):
+    def __init__(self, stiffness: Stiffness, intervals: int, degree: int = 4,
+                 segment: bool = False):
         self.K, self.d = int(intervals), int(degree)
         tau, C, D, B, A = legendre_tables(self.d)
         K, d = self.K, self.d
         self.tau = tau
         self.n_w = 2 * K * (d + 1)
-        self.n_p = 4 + K + stiffness.params.size
+        n_stiff = stiffness.params.size
+        self.n_p = 4 + K + n_stiff + (2 if segment else 0)
         w = ca.SX.sym("w", self.n_w)
         P = ca.SX.sym("P", self.n_p)
         F, alpha, L, ei_r = P[0], P[1], P[2], P[3]
         widths = P[4:4 + K]
-        ps = P[4 + K:]
+        ps = P[4 + K:4 + K + n_stiff]
         Z = ca.reshape(w, 2, K * (d + 1))
-        kappa = F * L ** 2 / ei_r
+        if segment:
+            # the force's components F, alpha -> κ_x, κ_y: μ' = κ_x sin ψ - κ_y cos ψ
+            start, mu_end = P[4 + K + n_stiff], P[5 + K + n_stiff]
+            kx, ky = F * L ** 2 / ei_r, alpha * L ** 2 / ei_r
+            kappa = ca.sqrt(1 + kx ** 2 + ky ** 2) - 1     # the scale 1 + κ, smooth at κ = 0
+
+            def moment_rate(psi):
+                return kx * ca.sin(psi) - ky * ca.cos(psi)
+
+            def moment_rate_psi(psi):
+                return kx * ca.cos(psi) + ky * ca.sin(psi)
+        else:
+            start, mu_end = 0.0, None
+            kappa = F * L ** 2 / ei_r
+
+            def moment_rate(psi):
+                return -kappa * ca.sin(psi + alpha)
+
+            def moment_rate_psi(psi):
+                return -kappa * ca.cos(psi + alpha)
         res = []
         u_nodes, psi_nodes, mu_nodes, x_nodes, y_nodes = [], [], [], [], []
         u0 = x0 = y0 = 0
@@ -122,13 +150,14 @@ class BeamTranscription:
             for k in range(1, d + 1):
                 u = u0 + tau[k] * h
                 zp = sum(C[r, k] * cols[r] for r in range(d + 1))
-                e_ratio = ei_r / stiffness.ei_casadi(L * u, ps)
-                f = ca.vertcat(cols[k][1] * e_ratio, -kappa * ca.sin(cols[k][0] + alpha))
+                e_ratio = ei_r / stiffness.ei_casadi(L * u if mu_end is None else start + L * u,
+                                                     ps)
+                f = ca.vertcat(cols[k][1] * e_ratio, moment_rate(cols[k][0]))
                 res.append((zp / h - f) / (1 + kappa))   # O(1) scale: tolerances are relative
                 cos_c.append(ca.cos(cols[k][0]))
                 sin_c.append(ca.sin(cols[k][0]))
                 e.append(e_ratio)
-                q.append(-kappa * ca.cos(cols[k][0] + alpha))
+                q.append(moment_rate_psi(cols[k][0]))
                 defects.append(zp / h - f)
             intervals.append(Interval(h, ca.horzcat(*cols), ca.vertcat(*e), ca.vertcat(*q),
                                       ca.horzcat(*defects)))
@@ -136,7 +165,7 @@ class BeamTranscription:
             if j < K - 1:
                 res.append(Z[:, (j + 1) * (d + 1)] - end)          # continuity
             else:
-                res.append(end[1])                                 # μ(1) = 0
+                res.append(end[1] if mu_end is None else end[1] - mu_end)  # μ(1) = μ_end
             # nodes of this interval: its start, then its collocation points
             u_nodes.append(u0)
             psi_nodes.append(cols[0][0])
@@ -158,25 +187,26 @@ class BeamTranscription:
         x_nodes.append(x0)
         y_nodes.append(y0)
         #: the residual G(w, P)
-        self.residual = ca.Function("beam_residual", [w, P], [ca.vertcat(*res)], ["w", "P"], ["G"])
+        name = "beam_segment" if segment else "beam"
+        self.residual = ca.Function(f"{name}_residual", [w, P], [ca.vertcat(*res)], ["w", "P"], ["G"])
         #: (w, P) -> s, x, y, ψ, M at the nodes (SI)
         self.shape = ca.Function(
-            "beam_shape", [w, P],
+            f"{name}_shape", [w, P],
             [L * ca.vertcat(*u_nodes), L * ca.vertcat(*x_nodes), L * ca.vertcat(*y_nodes),
              ca.vertcat(*psi_nodes), ei_r / L * ca.vertcat(*mu_nodes)],
             ["w", "P"], ["s", "x", "y", "psi", "M"])
         #: (w, P) -> load point (x, y, ψ) in m, m, rad
-        self.tip = ca.Function("beam_tip", [w, P],
+        self.tip = ca.Function(f"{name}_tip", [w, P],
                                [ca.vertcat(L * x0, L * y0, psi_nodes[-1])], ["w", "P"], ["tip"])
         # checks after a solve, sharing subexpressions with the residual:
         # max |G| with the shape (fine solves) or with the tip (coarse solves)
         g_max = ca.mmax(ca.fabs(ca.vertcat(*res)))
-        self.shape_check = ca.Function("beam_shape_check", [w, P],
+        self.shape_check = ca.Function(f"{name}_shape_check", [w, P],
                                        [*self.shape(w, P), g_max])
-        self.tip_check = ca.Function("beam_tip_check", [w, P], [self.tip(w, P), g_max])
+        self.tip_check = ca.Function(f"{name}_tip_check", [w, P], [self.tip(w, P), g_max])
         #: (w, P) -> max |G|, and w after one Newton step (design/solve/beam/condensed.py)
-        self.residual_norm = ca.Function("beam_residual_norm", [w, P], [g_max])
-        self.newton_step = ca.Function("beam_newton_step", [w, P],
+        self.residual_norm = ca.Function(f"{name}_residual_norm", [w, P], [g_max])
+        self.newton_step = ca.Function(f"{name}_newton_step", [w, P],
                                        [w + condensed_step(intervals, C, D)])
         self._cache: dict[tuple, object] = {}
 
@@ -250,15 +280,16 @@ def adapted_widths(intervals: int, stiffness: Stiffness, guesses: Sequence[BeamS
 _TRANSCRIPTIONS: dict[tuple, BeamTranscription] = {}
 
 
-def transcription(stiffness: Stiffness, intervals: int, degree: int = 4) -> BeamTranscription:
+def transcription(stiffness: Stiffness, intervals: int, degree: int = 4,
+                  segment: bool = False) -> BeamTranscription:
     """Shared :class:`BeamTranscription` for this stiffness structure and mesh.
 
     Building one costs 10-100 ms; fingers that differ only in their
     parameters (E, EI, the exponential's coefficients) share it.
     """
-    key = (stiffness.symbolic_key(), int(intervals), int(degree))
+    key = (stiffness.symbolic_key(), int(intervals), int(degree), bool(segment))
     if key not in _TRANSCRIPTIONS:
-        _TRANSCRIPTIONS[key] = BeamTranscription(stiffness, intervals, degree)
+        _TRANSCRIPTIONS[key] = BeamTranscription(stiffness, intervals, degree, segment)
     return _TRANSCRIPTIONS[key]
 
 

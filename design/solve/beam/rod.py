@@ -11,6 +11,12 @@ Parameters P = [κ (3), L, EI_r, h_1..h_K, p_EI..., p_EIout..., p_GJ...]:
 the load κ = F L² / EI_r in the finger frame, the loaded length, the
 reference rigidity, the interval widths (summing to 1) and the three
 stiffness profiles' parameters.
+
+A *segment* (``segment=True``) is the part of a finger from arc length s0
+to s0 + L, clamped in its own frame at its start, with a point moment at its
+end as well as the force: P then ends with [s0, μ_end (3)], μ_end = M L /
+EI_r, and μ(1) = μ_end. Two segments make a finger loaded at two points
+(design/solve/contact/spatial_belt_equations.py).
 """
 
 from __future__ import annotations
@@ -83,18 +89,20 @@ class RodTranscription:
         (w, P) -> s (m), r (3 x n, m), m (3 x n, N m) at the nodes.
     """
 
-    def __init__(self, stiffness: RodStiffness, intervals: int, degree: int = 4):
+    def __init__(self, stiffness: RodStiffness, intervals: int, degree: int = 4,
+                 segment: bool = False):
         self.K, self.d = int(intervals), int(degree)
         tau, C, D, B, A = legendre_tables(self.d)
         K, d = self.K, self.d
         self.tau = tau
         self.n_w = N_STATE * K * (d + 1)
         n_stiff = stiffness.params.size
-        self.n_p = 5 + K + n_stiff
+        self.n_p = 5 + K + n_stiff + (4 if segment else 0)
         w = ca.SX.sym("w", self.n_w)
         P = ca.SX.sym("P", self.n_p)
         kappa, L, ei_r = P[0:3], P[3], P[4]
-        widths, ps = P[5:5 + K], P[5 + K:]
+        widths, ps = P[5:5 + K], P[5 + K:5 + K + n_stiff]
+        start, mu_end = (P[5 + K + n_stiff], P[6 + K + n_stiff:]) if segment else (0.0, None)
         Z = ca.reshape(w, N_STATE, K * (d + 1))
         scale = ca.sqrt(1 + ca.dot(kappa, kappa))     # smooth at κ = 0, ~1 + |κ|
         res = []
@@ -108,7 +116,8 @@ class RodTranscription:
             tangents = []
             for k in range(1, d + 1):
                 u = u0 + tau[k] * h
-                ratios = ca.vertcat(*[ei_r / v for v in stiffness.casadi(L * u, ps)])
+                s = L * u if mu_end is None else start + L * u
+                ratios = ca.vertcat(*[ei_r / v for v in stiffness.casadi(s, ps)])
                 q_dot, mu_dot, d1 = rod_rates(cols[k][:4], cols[k][4:], kappa, ratios)
                 zp = sum(C[r, k] * cols[r] for r in range(d + 1))
                 res.append((zp / h - ca.vertcat(q_dot, mu_dot)) / scale)
@@ -117,7 +126,7 @@ class RodTranscription:
             if j < K - 1:
                 res.append(Z[:, (j + 1) * (d + 1)] - end)            # continuity
             else:
-                res.append(end[4:])                                  # μ(1) = 0
+                res.append(end[4:] if mu_end is None else end[4:] - mu_end)  # μ(1) = μ_end
             s_nodes.append(u0)
             r_nodes.append(r0)
             mu_nodes.append(cols[0][4:])
@@ -131,9 +140,10 @@ class RodTranscription:
         r_nodes.append(r0)
         mu_nodes.append(end[4:])
         frame = quaternion_rotation(end[:4])
-        self.residual = ca.Function("rod_residual", [w, P], [ca.vertcat(*res)], ["w", "P"], ["G"])
-        self.tip = ca.Function("rod_tip", [w, P], [L * r0, frame], ["w", "P"], ["r", "frame"])
-        self.shape = ca.Function("rod_shape", [w, P],
+        name = "rod_segment" if segment else "rod"
+        self.residual = ca.Function(f"{name}_residual", [w, P], [ca.vertcat(*res)], ["w", "P"], ["G"])
+        self.tip = ca.Function(f"{name}_tip", [w, P], [L * r0, frame], ["w", "P"], ["r", "frame"])
+        self.shape = ca.Function(f"{name}_shape", [w, P],
                                  [L * ca.vertcat(*s_nodes), L * ca.horzcat(*r_nodes),
                                   ei_r / L * ca.horzcat(*mu_nodes)],
                                  ["w", "P"], ["s", "r", "m"])
@@ -154,12 +164,12 @@ class RodTranscription:
 _CACHE: dict[tuple, RodTranscription] = {}
 
 
-def rod_transcription(stiffness: RodStiffness, intervals: int, degree: int = 4
-                      ) -> RodTranscription:
+def rod_transcription(stiffness: RodStiffness, intervals: int, degree: int = 4,
+                      segment: bool = False) -> RodTranscription:
     """Shared :class:`RodTranscription` for this stiffness structure and mesh."""
-    key = (stiffness.symbolic_key(), int(intervals), int(degree))
+    key = (stiffness.symbolic_key(), int(intervals), int(degree), bool(segment))
     if key not in _CACHE:
-        _CACHE[key] = RodTranscription(stiffness, intervals, degree)
+        _CACHE[key] = RodTranscription(stiffness, intervals, degree, segment)
     return _CACHE[key]
 
 

@@ -143,6 +143,14 @@ class SpatialSolution:
     penetration: float = 0.0
     shape_points: np.ndarray | None = None
     extras: dict = field(default_factory=dict)
+    #: the finger's force on the belt (N, finger frame; None: not on the
+    #: belt), its normal part, the tip where it acts, and how far the
+    #: finger's deepest point lies below the belt (m) (design/solve/contact/
+    #: spatial_belt.py)
+    belt_force: np.ndarray | None = None
+    belt_normal_force: float = 0.0
+    belt_point: np.ndarray | None = None
+    below_belt: float = 0.0
 
     @property
     def out_of_plane(self) -> float:

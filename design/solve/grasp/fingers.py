@@ -24,6 +24,16 @@ Model only what can touch: :func:`reach_windows` finds, from the undeformed
 finger loci (eq. 5.1), the time windows in which a finger can reach the bird
 at all; outside them no contact problem is built or solved, and inside them
 none either while the straight finger misses the bird (:func:`straight_level`).
+
+The belt. A finger whose straight tip would pass below the belt's surface
+(design/physics/belt.py) rests on it: the belt pushes its tip up and drags
+it with friction at the finger-belt µ against the tip's sliding over the
+moving belt, and the bird meets the finger so bent. Such a finger is solved
+with the belt while it is inside its reach windows: at accepted instants
+always (its force on the belt is reported), in trial evaluations only while
+the bird comes within the tip's depth below the belt of the straight finger
+(the finger bends up by at most that much). A finger pushed into the belt
+by the bird is solved with the belt from then on.
 """
 
 from __future__ import annotations
@@ -32,14 +42,18 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from design.physics.belt import Belt
 from design.physics.bird import Bird, Loads
-from design.physics.contact import ContactSolution
+from design.physics.contact import ContactSolution, straight_overlap
 from design.physics.ellipse import Ellipse
 from design.physics.grasper import Grasper
 from design.physics.kinematics import Ellipsoid
 from design.solve.contact import RobustContact
 from design.solve.contact.spatial import (FrictionLaw, Quadric, SpatialContact,
-                                          SpatialSolution, segment_level)
+                                          SpatialSolution, SpatialState, segment_level)
+from design.solve.contact.belt_continuation import BIRD_MODES, Belted, Plane
+from design.solve.contact.planar_belt import PlanarBeltContact
+from design.solve.contact.spatial_belt import SpatialBeltContact
 
 #: finite-difference step (s) for the rates the friction direction needs
 RATE_STEP = 1e-6
@@ -58,6 +72,10 @@ FRICTION_SPEED = 0.02
 MISSES = 1e-9
 #: the friction-reversal margin (m/s) reported where no finger's friction can reverse
 NO_REVERSAL = 1.0
+#: a planar finger meets the belt only where its bending plane is at least this
+#: far (rad) from the belt's plane: rigid out of its plane, it cannot bend onto
+#: a belt nearly parallel to it
+PLANAR_BELT_ANGLE = np.radians(3.0)
 
 
 @dataclass
@@ -82,6 +100,11 @@ class FingerState:
     @property
     def magnitude(self) -> float:
         return float(np.linalg.norm(self.force))
+
+    @property
+    def belt_force(self) -> float:
+        """The finger's normal force on the belt (N; 0 off the belt)."""
+        return float(getattr(self.solution, "belt_normal_force", 0.0))
 
 
 def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end: float,
@@ -157,22 +180,40 @@ class PlanarFinger:
         self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
                                     reversal_speed=reversal_speed)
         self.reverses = friction > 0 and self.settles_friction
+        self._belted: PlanarBeltContact | None = None
+
+    @property
+    def belted(self) -> PlanarBeltContact:
+        """The solver with the belt (built on first use: most fingers never need it)."""
+        if self._belted is None:
+            self._belted = PlanarBeltContact(self.solver)
+        return self._belted
 
     def reversal_margin(self, state, kin_factory) -> float:
         """:meth:`RobustContact.reversal_margin` of a contact state (m/s)."""
         state = state.with_ellipse()
         return self.solver.reversal_margin(state, kin_factory(state.ellipse))
 
-    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
         """(force on the bird (3,) world, contact point (3,) world, solution,
         state to continue from); force None when the plane misses the bird.
         A trial evaluation continued from a contact is first tried in one
-        Newton solve (:meth:`RobustContact.continue_trial`)."""
+        Newton solve (:meth:`RobustContact.continue_trial`). ``belt``:
+        (plane, friction law) in the finger frame where the finger may meet
+        the belt, else None; the planar finger meets it in its bending plane
+        (:meth:`_line`)."""
+        line = self._line(belt)
+        length = self.solver.finger.length
+        if line is not None and (isinstance(start, Belted) or
+                                 line[0].level(np.array([[length], [0.0]]))[0] < 0.0):
+            return self._belted_solve(body, base, R, kin_factory,
+                                      start if isinstance(start, Belted) else None, commit, line)
+        start = None if isinstance(start, Belted) else start
         if not commit and start is not None:
             center, B, rhs = body.section(base, R)
             trial = self.solver.continue_trial(start, center, B) if rhs > 0.0 else None
             if trial is not None:
-                return self._world(base, R, *trial)
+                return self._checked(body, base, R, kin_factory, commit, line, *trial)
         cut = body.cut(base, R)
         if cut is None:
             return None, None, None, None
@@ -188,7 +229,67 @@ class PlanarFinger:
 
         sol, cont = self.solver.solve_frame(cut, "auto", kin if self.settles_friction else None,
                                             start, settle=commit, detail=commit)
+        return self._checked(body, base, R, kin_factory, commit, line, sol, cont)
+
+    def _checked(self, body, base, R, kin_factory, commit, line, sol, cont):
+        """A bird-only solution, or, where it pushes the tip below the belt,
+        the solution with the belt continued from it."""
+        if line is not None and sol.contact and cont is not None:
+            psi, arc = sol.psi, sol.arc_length
+            tip = np.asarray(sol.point) + (self.solver.finger.length - arc) * np.array(
+                [np.cos(psi), np.sin(psi)])
+            if line[0].level(tip[:, None])[0] < 0.0:
+                start = self.belted.adopt(cont, *line)
+                return self._belted_solve(body, base, R, kin_factory, start, commit, line)
         return self._world(base, R, sol, cont)
+
+    @staticmethod
+    def _line(belt) -> tuple[Plane, np.ndarray] | None:
+        """The belt in the bending plane: its line and friction law ([µ, ε,
+        a (2), G (4)]: the finger's in-plane sliding over the belt, a + G p);
+        None without a belt, or where the bending plane lies within
+        PLANAR_BELT_ANGLE of the belt's (the planar finger, rigid out of its
+        plane, cannot bend onto it)."""
+        if belt is None:
+            return None
+        plane, law = belt
+        size = float(np.linalg.norm(plane.normal[:2]))
+        if size < np.sin(PLANAR_BELT_ANGLE):
+            return None
+        law = FrictionLaw.of(law)
+        return Plane(plane.normal[:2] / size, plane.offset / size), np.concatenate(
+            [[law.mu, law.speed], law.sliding_at_origin[:2], law.sliding_gradient[:2, :2].ravel()])
+
+    def _belted_solve(self, body, base, R, kin_factory, start, commit, line):
+        """The finger with the belt; the bird's section taken in where the
+        plane cuts the bird near enough for the bent finger to reach it."""
+        center, B, rhs = body.section(base, R)
+        length = self.solver.finger.length
+        depth = -line[0].level(np.array([[length], [0.0]]))[0]
+        conic = None
+        if rhs > 0.0 and (straight_overlap(center, _grown_conic(B, depth), length) < 0.0
+                          or (start is not None and start.bird is not None)):
+            conic = (center, B)
+        tau_mu = self._bird_friction(start, conic, kin_factory, body, base, R)
+        sol, cont = self.belted.solve(conic, tau_mu, *line, previous=start, detail=commit)
+        return self._world(base, R, sol, cont)
+
+    def _bird_friction(self, start, conic, kin_factory, body, base, R) -> float:
+        """The bird's signed friction τµ for a finger on the belt: the
+        contact's own while it lasts, else from the rigid finger's sliding
+        over the bird where the straight finger comes nearest to it."""
+        mu = self.solver.mu
+        if mu == 0.0 or conic is None:
+            return 0.0
+        if not self.settles_friction:
+            return mu
+        if start is not None and start.mode in BIRD_MODES:
+            return float(start.friction[0])
+        center, B = conic
+        x = float(np.clip(center[0] + B[0, 1] * center[1] / B[0, 0], 0.0,
+                          self.solver.finger.length))
+        v_object = kin_factory(body.cut(base, R))(np.array([x, 0.0]))[1]
+        return mu if v_object[0] >= 0.0 else -mu
 
     @staticmethod
     def _world(base, R, sol, cont):
@@ -226,23 +327,83 @@ class SpatialFinger:
     def __init__(self, finger, friction: float, intervals: int, degree: int):
         self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
         self.mu = float(friction)
+        self._belted: SpatialBeltContact | None = None
 
-    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool):
+    @property
+    def belted(self) -> SpatialBeltContact:
+        """The solver with the belt (built on first use: most fingers never need it)."""
+        if self._belted is None:
+            self._belted = SpatialBeltContact(self.solver)
+        return self._belted
+
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
+        """As :meth:`PlanarFinger.solve`; ``belt``: (plane, friction law) in the
+        finger frame where the finger may meet the belt, else None."""
         quadric = body_quadric(body, base, R)
-        if segment_level(quadric, self.solver.finger.length) >= 0.0:
+        misses = segment_level(quadric, self.solver.finger.length) >= 0.0
+        resting = belt is not None and belt[0].level(
+            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        if belt is not None and (resting or isinstance(start, Belted)):
+            return self._belted_solve(body, quadric, base, R, kin_factory,
+                                      start if isinstance(start, Belted) else None, commit, belt)
+        if misses:
             return None, None, None, None
-        friction = FrictionLaw()
-        if self.mu > 0:
-            # the object's velocity field is affine in the point: sample it at 0 and e_i
-            kin = kin_factory(quadric)
-            v0 = kin(np.zeros(3))[1]
-            gradient = np.column_stack([kin(e)[1] - v0 for e in np.eye(3)])
-            friction = FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-v0,
-                                   sliding_gradient=-gradient)
-        sol, cont = self.solver.solve(quadric, friction, start, detail=commit)
+        start = start if isinstance(start, SpatialState) else None
+        sol, cont = self.solver.solve(quadric, self._law(kin_factory, quadric), start,
+                                      detail=commit)
+        if belt is not None and sol.contact and cont is not None and \
+                belt[0].level(self._tip(sol, cont)[:, None])[0] < 0.0:
+            # pushed into the belt by the bird: solved with it from the bird-only state
+            return self._belted_solve(body, quadric, base, R, kin_factory,
+                                      self.belted.adopt(cont, *belt), commit, belt)
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
+
+    def _law(self, kin_factory, quadric) -> FrictionLaw:
+        """The bird's friction law in the finger frame: regularised Coulomb
+        against the rigid finger's sliding over the bird's surface."""
+        if self.mu <= 0:
+            return FrictionLaw()
+        # the object's velocity field is affine in the point: sample it at 0 and e_i
+        kin = kin_factory(quadric)
+        v0 = kin(np.zeros(3))[1]
+        gradient = np.column_stack([kin(e)[1] - v0 for e in np.eye(3)])
+        return FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-v0,
+                           sliding_gradient=-gradient)
+
+    def _tip(self, sol: SpatialSolution, state: SpatialState) -> np.ndarray:
+        """The finger's tip (finger frame) in a bird-only contact."""
+        post = state.post
+        return post[:3] + post[13:16] * (self.solver.finger.length - post[4])
+
+    def _belted_solve(self, body, quadric, base, R, kin_factory, start, commit, belt):
+        """The finger with the belt; the bird taken in only where the finger may reach it."""
+        near = segment_level(_grown(quadric, -belt[0].level(
+            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0]),
+            self.solver.finger.length) < 0.0
+        near = near or (start is not None and start.bird is not None)
+        sol, cont = self.belted.solve(quadric if near else None,
+                                      self._law(kin_factory, quadric) if near else FrictionLaw(),
+                                      belt[0], belt[1], start, detail=commit)
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        return R @ sol.force, base + R @ sol.point, sol, cont
+
+
+def _grown_conic(B: np.ndarray, margin: float) -> np.ndarray:
+    """The conic matrix of an ellipse with every semi-axis longer by ``margin`` (m)."""
+    values, vectors = np.linalg.eigh(B)
+    axes = 1.0 / np.sqrt(values) + max(margin, 0.0)
+    return vectors @ np.diag(1.0 / axes ** 2) @ vectors.T
+
+
+def _grown(quadric: Quadric, margin: float) -> Quadric:
+    """The ellipsoid ``quadric`` with every semi-axis longer by ``margin`` (m):
+    it contains every point within ``margin`` of the original."""
+    values, vectors = np.linalg.eigh(quadric.matrix)
+    axes = 1.0 / np.sqrt(values) + max(margin, 0.0)
+    return Quadric(quadric.center, vectors @ np.diag(1.0 / axes ** 2) @ vectors.T)
 
 
 class ThesisPlanarFinger(PlanarFinger):
@@ -261,12 +422,15 @@ class ThesisPlanarFinger(PlanarFinger):
 FINGER_MODELS = {m.name: m for m in (PlanarFinger, ThesisPlanarFinger, SpatialFinger)}
 
 
-def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
+def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length,
+                   grow: float = 0.0):
     """min over the straight finger (base + x axis, 0 ≤ x ≤ length) of the
     bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
     1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
-    For n fingers at once: base and axis (n, 3), length (n,); returns (n,)."""
-    scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
+    For n fingers at once: base and axis (n, 3), length (n,); returns (n,).
+    ``grow`` (m): the bird with every semi-axis that much longer (it then
+    holds every point within ``grow`` of the bird)."""
+    scale = 1.0 / (np.array([body.eta, body.lam, body.gamma]) + grow)
     p = scale * ((base - np.asarray(body.center)) @ body.rotation)
     e = scale * (axis @ body.rotation)
     x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
@@ -293,8 +457,12 @@ class FingerForces:
 
     def __init__(self, grasper: Grasper, bird: Bird, drum_speed: float, friction: float,
                  windows: list[list[tuple[float, float]]] | None = None,
-                 intervals: int = 8, degree: int = 4, model: str = "planar"):
+                 intervals: int = 8, degree: int = 4, model: str = "planar",
+                 belt: Belt = Belt(), belt_friction: float = 0.0):
         self.grasper, self.bird = grasper, bird
+        self.belt, self.belt_friction = belt, float(belt_friction)
+        #: the belt's speed (m/s) at time t; the grasp that drives the belt sets it
+        self.belt_speed = lambda t: 0.0
         self.drum = grasper.drum(drum_speed)
         kind = FINGER_MODELS[model]
         self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
@@ -337,10 +505,12 @@ class FingerForces:
         bases, rotations = self.frames(t)
         return bases[i], rotations[i]
 
-    def reaching(self, t: float, body: Ellipsoid) -> set[int]:
-        """The fingers whose straight line enters the bird at time t (level ≤
-        MISSES), among those inside their reach windows (the others count as
-        skipped)."""
+    def reaching(self, t: float, body: Ellipsoid, commit: bool = False) -> set[int]:
+        """The fingers to solve at time t, among those inside their reach
+        windows (the others count as skipped): those whose straight line
+        enters the bird (level ≤ MISSES), and those resting on the belt (the
+        straight tip below it), at an accepted instant all of them, else while
+        the bird comes within the tip's depth of the straight finger."""
         if self._window_ends is None:
             inside = np.arange(len(self.models))
         else:
@@ -350,9 +520,39 @@ class FingerForces:
         if inside.size == 0:
             return set()
         bases, rotations = self.frames(t)
-        level = straight_level(body, bases[inside], rotations[inside, :, 0],
-                               self._lengths[inside])
-        return set(inside[level <= MISSES].tolist())
+        axes, lengths = rotations[inside, :, 0], self._lengths[inside]
+        out = set(inside[straight_level(body, bases[inside], axes, lengths) <= MISSES].tolist())
+        tips = bases[inside] + axes * lengths[:, None]
+        depth = -tips[:, 2]
+        resting = (depth > 0) & np.array([self.belt.touches(self.grasper.fingers[i].design_name,
+                                                           tip[1]) for i, tip in zip(inside, tips)])
+        if commit:
+            return out | set(inside[resting].tolist())
+        for k in np.flatnonzero(resting):
+            if straight_level(body, bases[inside[k]], axes[k], lengths[k], grow=depth[k]) <= MISSES:
+                out.add(int(inside[k]))
+        return out
+
+    def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
+        """The belt as finger i sees it at time t: the plane Z = 0 and the
+        friction law against the finger's sliding over the moving belt, in
+        the finger frame; None where the finger passes beside it or through
+        a slot (judged at its straight tip)."""
+        base, R = self.frame(i, t)
+        tip = base + R[:, 0] * self._lengths[i]
+        if not self.belt.touches(self.grasper.fingers[i].design_name, tip[1]):
+            return None
+        plane = Plane(R[2].copy(), -float(base[2]))
+        if self.belt_friction <= 0.0:
+            return plane, FrictionLaw()
+        dt = RATE_STEP
+        base2, R2 = self.frame(i, t + dt)
+        belt = np.array([self.belt_speed(t) * dt, 0.0, 0.0])
+        # the belt's material velocity relative to the finger frame at r: v0 + G r
+        v0 = R2.T @ (base + belt - base2) / dt
+        G = (R2.T @ R - np.eye(3)) / dt
+        return plane, FrictionLaw(mu=self.belt_friction, speed=FRICTION_SPEED,
+                                  sliding_at_origin=-v0, sliding_gradient=-G)
 
     def ellipsoid(self, y: np.ndarray) -> Ellipsoid:
         b = self.bird
@@ -376,7 +576,7 @@ class FingerForces:
         body = self.ellipsoid(y)
         loads, states = Loads(), []
         centre = np.array([y[0], 0.0, y[1]])
-        reaching = self.reaching(t, body)
+        reaching = self.reaching(t, body, commit)
         for i, gf in enumerate(self.grasper.fingers):
             force = None
             if i in reaching:
@@ -389,7 +589,7 @@ class FingerForces:
                 start = self.states[i] if commit or model.from_committed else self.trials[i]
                 force, p_w, sol, cont = model.solve(
                     body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
-                    commit)
+                    commit, self.belt_contact(i, t))
             if force is None:                       # out of reach: no contact problem
                 self.trials[i] = None
                 if commit:
@@ -444,7 +644,8 @@ class FingerForces:
         step it did and accepts that instant instead. (A finger that touches
         again after a trial without contact starts from first touch with a
         guessed friction, which the next accepted instant settles: not a
-        reversal.)"""
+        reversal.) A finger on the belt keeps its friction's sense
+        (design/solve/contact/planar_belt.py)."""
         key = (t, y.tobytes())
         if key not in self._margins:
             if len(self._margins) > 16:
@@ -455,7 +656,8 @@ class FingerForces:
                     i, t, y, shape))
                 for i, st in enumerate(states)
                 if self.models[i].reverses and st.point is not None and st.continued is not None
-                and self.states[i] is not None
+                and self.states[i] is not None and not isinstance(st.continued, Belted)
+                and not isinstance(self.states[i], Belted)
                 and st.continued.tau_mu == self.states[i].tau_mu])
         return self._margins[key]
 

@@ -135,6 +135,7 @@ class Grasp:
     def __init__(self, dynamics: BirdDynamics, conveyor: Conveyor, fingers: FingerForces):
         self.dyn, self.conveyor, self.fingers = dynamics, conveyor, fingers
         self.start: float | None = conveyor.start_time if conveyor.decelerates else None
+        fingers.belt_speed = lambda t: self.belt(t)[0]
 
     def belt(self, t: float) -> tuple[float, float]:
         return self.conveyor.velocity(t, self.start)

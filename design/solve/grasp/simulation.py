@@ -8,12 +8,13 @@ from functools import cached_property
 
 import numpy as np
 
+from design.physics.belt import Belt
 from design.physics.bird import Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
 from design.solve.grasp.fingers import FingerForces, FingerState, reach_windows
 from design.solve.grasp.integrate import Grasp, IntegratorSettings, Trajectory, integrate
 from design.solve.grasp.peaks import merged_peaks
-from design.solve.grasp.validity import contact_validity
+from design.solve.grasp.validity import belt_contacts, contact_validity
 
 
 #: the spatial rod's collocation intervals: 3 change hold and peak by under
@@ -37,6 +38,14 @@ class GraspSetup:
     duration: float
     #: the fingers' contact model: ``spatial`` (rod) or ``planar`` (thesis, default)
     finger_model: str = "planar"
+    #: where the fingers can meet the belt (default: a solid belt)
+    belt: Belt = Belt()
+    #: the finger-belt friction coefficient (None: the conveyor's, ``conveyor_friction``)
+    belt_friction: float | None = None
+
+    @property
+    def finger_belt_friction(self) -> float:
+        return self.conveyor_friction if self.belt_friction is None else self.belt_friction
 
 
 @dataclass
@@ -73,7 +82,8 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     b, conv = setup.bird, setup.conveyor
     windows = setup_reach_windows(setup) if reach_filter else None
     fingers = FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction, windows,
-                           intervals=contact_nodes, model=setup.finger_model)
+                           intervals=contact_nodes, model=setup.finger_model, belt=setup.belt,
+                           belt_friction=setup.finger_belt_friction)
     dyn = BirdDynamics(b, setup.legs, setup.conveyor_friction)
     grasp = Grasp(dyn, conv, fingers)
     y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])
@@ -156,6 +166,7 @@ def summarise(run: GraspRun) -> dict:
         "min_normal_force_N": float(min(r.normal for r in recs)),
         "finger_model": run.setup.finger_model,
         "validity": validity,
+        "belt_contacts": belt_contacts(run),
         "events": [[t, name] for t, name in run.trajectory.events],
         # fixed-step (bdf4) runs only: the adaptive integrator controls its error
         "local_error_estimate": None if run.trajectory.local_error is None else {

@@ -15,10 +15,11 @@
   t = 0, a finger pressing on it) begins inside a grasp that no finger
   swept into: its first hold window is an artefact of the start, and the
   run says so.
-* A finger that passes below the conveyor's surface under the bird is
-  reported: the thesis's birds and football sit on pallets at least as wide
-  as the bird (§A, Fig 1-1), so a finger point below Z = 0 within the bird's
-  footprint (|Y| < λ, |X - X_bird| < η) would cut through the pallet.
+* A finger that passes below the belt's surface where the belt is (design/
+  physics/belt.py: a solid belt by default) by more than BELT_TOLERANCE is
+  reported: the fingers rest on the belt with their tips, and a finger
+  lying on it along its length, or one solved without the belt, would cut
+  through it.
 """
 
 from __future__ import annotations
@@ -35,6 +36,8 @@ from design.solve.beam import solve_beam
 FOLD_SLOPE = np.radians(80.0)
 #: largest out-of-plane share of the contact normal the planar model may see
 PLANAR_LIMIT = 0.3
+#: a finger point this far (m) below the belt's surface is reported
+BELT_TOLERANCE = 1e-4
 
 
 @lru_cache(maxsize=64)
@@ -60,10 +63,12 @@ def contact_validity(run, peaks: np.ndarray, peak_times: np.ndarray) -> dict:
     model stayed inside its limit."""
     recs = run.trajectory.records
     setup = run.setup
-    b = setup.bird
     drum = setup.grasper.drum(setup.drum_speed)
     per_finger, beyond, through = {}, [], []
     for i, gf in enumerate(setup.grasper.fingers):
+        below = _below_belt(setup, drum, gf, [(r.t, r.fingers[i]) for r in recs])
+        if below is not None:
+            through.append({"finger": gf.name, "time_s": below[0], "depth_m": below[1]})
         touching = [(r, r.fingers[i]) for r in recs if r.fingers[i].magnitude > 0]
         if not touching:
             continue
@@ -76,13 +81,6 @@ def contact_validity(run, peaks: np.ndarray, peak_times: np.ndarray) -> dict:
         if peak > bound:
             beyond.append({"finger": gf.name, "time_s": float(peak_times[i]), "force_N": peak,
                            "fold_force_N": bound})
-        for r, f in touching:
-            pts = _finger_points(drum, gf, r.t, f)
-            under = (pts[2] < 0) & (np.abs(pts[1]) < b.lam) & (np.abs(pts[0] - r.y[0]) < b.eta)
-            if np.any(under):
-                through.append({"finger": gf.name, "time_s": r.t,
-                                "depth_m": float(-pts[2][under].min())})
-                break
     worst = max((v["normal_out_of_plane_max"] for v in per_finger.values()), default=0.0)
     first = recs[0]
     held = [(gf.name, f.magnitude) for gf, f in zip(setup.grasper.fingers, first.fingers)
@@ -102,6 +100,38 @@ def _finger_points(drum, gf, t: float, state) -> np.ndarray:
     return base[:, None] + R @ pts
 
 
+def _below_belt(setup, drum, gf, states) -> tuple[float, float] | None:
+    """(time s, depth m) of the finger's deepest point below the belt where
+    the belt is, among its solved ``states`` [(t, FingerState)], if deeper
+    than BELT_TOLERANCE."""
+    deepest = None
+    for t, state in states:
+        if state.solution is None:
+            continue
+        pts = _finger_points(drum, gf, t, state)
+        on = np.array([setup.belt.touches(gf.design_name, y) for y in pts[1]])
+        if not np.any(on):
+            continue
+        depth = float(-pts[2][on].min())
+        if depth > BELT_TOLERANCE and (deepest is None or depth > deepest[1]):
+            deepest = (float(t), depth)
+    return deepest
+
+
+def belt_contacts(run) -> dict:
+    """Per finger that pressed on the belt: its largest normal force on it (N)
+    and when (s), and the first and last instants it touched (s)."""
+    recs = run.trajectory.records
+    out = {}
+    for i, gf in enumerate(run.setup.grasper.fingers):
+        on = [(r.t, r.fingers[i].belt_force) for r in recs if r.fingers[i].belt_force > 0.0]
+        if on:
+            t_max, f_max = max(on, key=lambda x: x[1])
+            out[gf.name] = {"max_force_N": f_max, "time_s": t_max, "first_s": on[0][0],
+                            "last_s": on[-1][0]}
+    return out
+
+
 def validity_problems(validity: dict) -> list[str]:
     """A run's reasons to distrust its model, in words (empty: none)."""
     out = []
@@ -111,8 +141,8 @@ def validity_problems(validity: dict) -> list[str]:
     out += [f"finger {b['finger']} pressed {b['force_N']:.1f} N, past its fold force "
             f"{b['fold_force_N']:.1f} N, at {b['time_s']:.3f} s"
             for b in validity["forces_beyond_fold"]]
-    out += [f"finger {b['finger']} passed {1e3 * b['depth_m']:.1f} mm through the belt under "
-            f"the bird at {b['time_s']:.3f} s" for b in validity["fingers_through_conveyor"]]
+    out += [f"finger {b['finger']} passed {1e3 * b['depth_m']:.1f} mm through the belt at "
+            f"{b['time_s']:.3f} s" for b in validity["fingers_through_conveyor"]]
     held = validity.get("held_at_start", [])
     if held:
         out.append("the bird starts held off the belt by finger(s) " + ", ".join(

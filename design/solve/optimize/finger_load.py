@@ -68,9 +68,12 @@ from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import finger_frame, rot_y, section
 from design.solve.beam.rod import RodStiffness
 from design.solve.compiled import compiled
+from design.solve.contact.belt_continuation import BELT_MODES
 from design.solve.contact.equations import MODES, contact_transcription
+from design.solve.contact.planar_belt_equations import planar_belt_transcription
 from design.solve.contact.robust import RobustContact
 from design.solve.contact.spatial import SpatialContact
+from design.solve.contact.spatial_belt_equations import belt_transcription, overhang_widths
 from design.solve.contact.spatial_equations import spatial_transcription
 from design.solve.grasp.fingers import FRICTION_SPEED, RATE_STEP
 
@@ -79,6 +82,25 @@ TOLERANCE, MAX_ITER = 1e-10, 30
 #: the outputs of a finger's function; its inputs are the model's sizes, then z0
 OUTPUTS = ["load", "force", "z"]
 DIFFERENTIABLE = [True, True, False]
+
+
+#: the contact modes the NLP can meet: the bird alone, or with the tip on the belt
+#: (a finger on the belt alone loads nothing)
+NLP_MODES = (*MODES, "tip+belt", "interior+belt")
+
+
+def _belt_motion(fp, g, t, gx, tilt, v):
+    """The belt in a finger frame at t: its upward normal (3,), offset e
+    (n·r = e on its surface, m) and the belt's material velocity relative to
+    the frame at r, v0 + G r (m/s; forward difference over RATE_STEP, as
+    the simulator's design/solve/grasp/fingers.py FingerForces.belt_contact)."""
+    base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
+    base2, R2 = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t + RATE_STEP, gx,
+                             tilt)
+    normal = R[2, :].T
+    v0 = R2.T @ (base + ca.vertcat(v * RATE_STEP, 0.0, 0.0) - base2) / RATE_STEP
+    G = (R2.T @ R - ca.DM.eye(3)) / RATE_STEP
+    return normal, -base[2], v0, G
 
 
 def _loads(f_w, r):
@@ -94,25 +116,29 @@ class PlanarStage:
     in-plane force with the schedule's friction sense τµ."""
 
     name = "planar"
-    #: sizes of the differentiable inputs, in order
-    sizes = {"pose": 3, "t": 1, "fp": 6, "g": 2, "k": 1, "tau_mu": 1}
-    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, then widths, stiffness params
-    n_fixed = 6
+    #: sizes of the differentiable inputs, in order (``belt``: its speed, m/s)
+    sizes = {"pose": 3, "t": 1, "fp": 6, "g": 2, "k": 1, "tau_mu": 1, "belt": 1}
+    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, finger-belt µ, ε, then
+    #: widths, stiffness params
+    n_fixed = 8
     #: the implicit-function adjoint's linear solver (the residual Jacobian's sparsity)
     solver = "qr"
     #: its stages are cheap (0.05 ms): serial
     threads = 1
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
-                 intervals: int, degree: int):
+                 belt_friction: float, intervals: int, degree: int):
         # the simulator's mesh and reference rigidity, so that its z are guesses here
         reference = RobustContact(gf.finger, friction, intervals, degree)
         self.stiffness, self.intervals, self.degree = gf.finger.stiffness, intervals, degree
         self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
-                                          bird.gamma, reference.ei_ref], reference.widths,
+                                          bird.gamma, reference.ei_ref, belt_friction,
+                                          FRICTION_SPEED], reference.widths,
                                          self.stiffness.params])
 
     def transcription(self, mode: str):
+        if mode in BELT_MODES:
+            return planar_belt_transcription(self.stiffness, self.intervals, self.degree, mode)
         return contact_transcription(self.stiffness, self.intervals, self.degree, mode,
                                      ellipse="conic")
 
@@ -121,13 +147,21 @@ class PlanarStage:
         """(q, load, force) of one stage in SX."""
         pose, t, fp, g = parts["pose"], parts["t"], parts["fp"], parts["g"]
         K = tr.beam.K
-        gx, tilt, eta, lam, gamma, ei_ref = (c[i] for i in range(cls.n_fixed))
+        gx, tilt, eta, lam, gamma, ei_ref, mu_belt, eps = (c[i] for i in range(cls.n_fixed))
         widths, params = c[cls.n_fixed:cls.n_fixed + K], c[cls.n_fixed + K:]
         base, R = finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], t, gx, tilt)
         centre = ca.vertcat(pose[0], 0.0, pose[1])
         u0, B, _ = section((eta, lam, gamma), (pose[0], 0.0, pose[1]), pose[2], base, R)
-        q = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], parts["tau_mu"], widths,
-                       params)
+        head = ca.vertcat(fp[5], ei_ref, u0, B[0, 0], B[0, 1], B[1, 1], parts["tau_mu"])
+        if tr.mode in BELT_MODES:
+            # the belt's line in the bending plane and its law (planar_belt_equations.py)
+            normal, offset, v0, G = _belt_motion(fp, g, t, gx, tilt, parts["belt"])
+            size = ca.norm_2(normal[:2])
+            line = ca.vertcat(normal[:2] / size, offset / size)
+            law = ca.vertcat(mu_belt, eps, -v0[:2], ca.vec((-G[:2, :2]).T))
+            q = ca.vertcat(head, line, law, widths, ca.DM(overhang_widths()), params)
+        else:
+            q = ca.vertcat(head, widths, params)
         post = tr.post(z, q)[0]
         x_l, y_l, force, alpha = post[0], post[1], parts["k"] * post[3], post[4]
         pressing = ca.fmax(force, 0.0)
@@ -146,9 +180,10 @@ class SpatialStage:
     the force along the surface normal plus friction."""
 
     name = "spatial"
-    sizes = {"state": 6, "t": 1, "fp": 6, "g": 2, "k": 1}
-    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, µ, ε, then widths, stiffness params
-    n_fixed = 8
+    sizes = {"state": 6, "t": 1, "fp": 6, "g": 2, "k": 1, "belt": 1}
+    #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, µ, ε, finger-belt µ, then
+    #: widths, stiffness params
+    n_fixed = 9
     #: dense LU, as the spatial rootfinder's (spatial_equations.py: 39 % full)
     solver = "lapacklu"
     #: the stages' contacts and Jacobian blocks over this many threads (at most the
@@ -157,23 +192,25 @@ class SpatialStage:
     threads = 2
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
-                 intervals: int, degree: int):
+                 belt_friction: float, intervals: int, degree: int):
         reference = SpatialContact(gf.finger, intervals, degree)
         self.stiffness = RodStiffness.of(gf.finger)
         self.intervals, self.degree = intervals, degree
         self.constants = np.concatenate([[grasper.x, grasper.tilt, bird.eta, bird.lam,
                                           bird.gamma, reference.ei_ref, friction,
-                                          FRICTION_SPEED], reference.widths,
+                                          FRICTION_SPEED, belt_friction], reference.widths,
                                          self.stiffness.params])
 
     def transcription(self, mode: str):
+        if mode in BELT_MODES:
+            return belt_transcription(self.stiffness, self.intervals, self.degree, mode)
         return spatial_transcription(self.stiffness, self.intervals, self.degree, mode)
 
     @classmethod
     def expressions(cls, tr, parts: dict, z, c):
         state, t, fp, g = parts["state"], parts["t"], parts["fp"], parts["g"]
         K = tr.rod.K
-        gx, tilt, eta, lam, gamma, ei_ref, mu, eps = (c[i] for i in range(cls.n_fixed))
+        gx, tilt, eta, lam, gamma, ei_ref, mu, eps, mu_belt = (c[i] for i in range(cls.n_fixed))
         widths, params = c[cls.n_fixed:cls.n_fixed + K], c[cls.n_fixed + K:]
         def frame(time):
             return finger_frame(fp[0], fp[1], fp[2], fp[3], fp[4], g[0], g[1], time, gx, tilt)
@@ -194,7 +231,13 @@ class SpatialStage:
         law = ca.vertcat(ca.DM.zeros(3), mu, eps, -v0, ca.vec((-G).T))
         quadric = ca.vertcat(c_f, Q_f[0, 0], Q_f[0, 1], Q_f[0, 2], Q_f[1, 1], Q_f[1, 2],
                              Q_f[2, 2])
-        q = ca.vertcat(fp[5], ei_ref, quadric, law, widths, params)
+        if tr.mode in BELT_MODES:
+            normal, offset, v0, G = _belt_motion(fp, g, t, gx, tilt, parts["belt"])
+            belt = ca.vertcat(ca.DM.zeros(3), mu_belt, eps, -v0, ca.vec((-G).T))
+            q = ca.vertcat(fp[5], ei_ref, quadric, law, normal, offset, belt, widths,
+                           ca.DM(overhang_widths()), params)
+        else:
+            q = ca.vertcat(fp[5], ei_ref, quadric, law, widths, params)
         post = tr.post(z, q)[0]
         point, normal_force, direction = post[0:3], post[3], post[7:10] + post[16:19]
         pressing = ca.fmax(parts["k"] * normal_force, 0.0)
@@ -252,13 +295,17 @@ def stage_functions(tr, n_c: int, model=PlanarStage) -> StageFunctions:
 
 
 class FingerLoad:
-    """``functions[mode]`` for one finger (mode ``interior`` or ``tip``) of
-    the finger model ``model`` (:data:`STAGE_MODELS`); ``compiled[mode]``:
-    (whether its SX parts run compiled, the compiler command or why not)."""
+    """:meth:`function` (mode) for one finger of the finger model ``model``
+    (:data:`STAGE_MODELS`), in the contact modes of :data:`NLP_MODES`, each
+    built when first asked for; ``compiled[mode]``: (whether its SX parts
+    run compiled, the compiler command or why not)."""
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
-                 intervals: int, degree: int = 4, model: str = "planar"):
-        self.model = STAGE_MODELS[model](gf, grasper, bird, friction, intervals, degree)
+                 intervals: int, degree: int = 4, model: str = "planar",
+                 belt_friction: float = 0.0):
+        self.model = STAGE_MODELS[model](gf, grasper, bird, friction, belt_friction, intervals,
+                                         degree)
+        self.gf = gf
         self.sizes = self.model.sizes
         #: the function's inputs, in order
         self.inputs = [*self.sizes, "z0"]
@@ -267,7 +314,13 @@ class FingerLoad:
         self._jacobians: dict = {}
         self._stages: dict = {}
         self._batches: dict = {}
-        self.functions = {m: self._build(gf, m) for m in MODES}
+        self._functions: dict = {}
+
+    def function(self, mode: str) -> ca.Function:
+        """The finger's load in contact mode ``mode`` (built on first use)."""
+        if mode not in self._functions:
+            self._functions[mode] = self._build(self.gf, mode)
+        return self._functions[mode]
 
     def _build(self, gf, mode) -> ca.Function:
         tr = self.model.transcription(mode)
@@ -295,7 +348,7 @@ class FingerLoad:
             blocks += ca.horzsplit(row, cuts) + [ca.MX(row.size1(), tr.n_z)]
         # z is the contact's state, an output to read, not to differentiate
         blocks += [ca.MX(tr.n_z, n) for n in [*sizes.values(), tr.n_z]]
-        name = f"finger_{gf.name}_{mode}"
+        name = f"finger_{gf.name}_{mode.replace('+', '_')}"
         jac = ca.Function(f"jac_{name}", [*x_j, ca.MX.sym("z0", tr.n_z), *outs], blocks,
                           [*inputs, *(f"out_{o}" for o in OUTPUTS)],
                           [f"jac_{o}_{i}" for o in OUTPUTS for i in inputs])
@@ -319,13 +372,14 @@ class FingerLoad:
         return sum(roots.solves * roots.n for _, roots in self._batches.values())
 
     def batch(self, mode: str, n: int) -> ca.Function:
-        """``functions[mode]`` at n stages in one call: every input and output
+        """:meth:`function` at n stages in one call: every input and output
         with a column per stage (CasADi's map, a loop in C++ instead of n
         calls in the NLP's graph), and its Jacobian, block-diagonal over the
         stages, from the stage Jacobians of one mapped call."""
         key = (mode, n)
         if key not in self._batches:
-            f, jac = self.functions[mode], self._jacobians[mode]
+            f = self.function(mode)
+            jac = self._jacobians[mode]
             name = f"{f.name()}_x{n}"
             ins = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
             outs = [ca.MX.sym(f"out_{o}", f.size1_out(k), n) for k, o in enumerate(OUTPUTS)]
@@ -337,7 +391,7 @@ class FingerLoad:
             jac_n = ca.Function(f"jac_{name}", [*ins, *outs], diagonal, jac.name_in(),
                                 jac.name_out())
             # the stages: kinematics, the contacts (solved once per point, see
-            # _Roots), loads; the same operations as n calls of functions[mode]
+            # _Roots), loads; the same operations as n calls of function(mode)
             st, c = self._stages[mode], ca.DM(self.constants)
             ins_f = [ca.MX.sym(i, f.size1_in(k), n) for k, i in enumerate(self.inputs)]
             x = ca.vertcat(*ins_f[:len(self.sizes)])

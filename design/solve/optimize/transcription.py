@@ -150,15 +150,16 @@ class DesignNLP:
                 for i, c in enumerate(st) if c is not None}
         self.fingers = {i: FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
                                       setup.finger_friction, settings.beam_intervals,
-                                      settings.degree, setup.finger_model)
+                                      settings.degree, setup.finger_model,
+                                      setup.finger_belt_friction)
                         for i in sorted(used)}
         self._modes = {}
+        self.objective = objective
+        self._build(run, cap, rules, box)
         #: (whether every finger function's SX parts run compiled, the reasons)
         states = [m for f in self.fingers.values() for m in f.compiled.values()]
         self.compiled = (all(c for c, _ in states),
                          sorted({reason for _, reason in states}))
-        self.objective = objective
-        self._build(run, cap, rules, box)
 
     # ------------------------------------------------------------ model
     def _mode_function(self, mode: str, sign: float) -> ca.Function:
@@ -207,8 +208,9 @@ class DesignNLP:
                 f = self.fingers[i].batch(mode, len(group))
                 fp, scale = design[i]
                 state = ca.horzcat(*[states[j, k] for j, k, _ in group])
-                given = {"pose": state[:3, :], "state": state,
-                         "t": ca.horzcat(*[times[j, k] for j, k, _ in group]),
+                stage_times = ca.horzcat(*[times[j, k] for j, k, _ in group])
+                given = {"pose": state[:3, :], "state": state, "t": stage_times,
+                         "belt": self._belt(stage_times, values)[0],
                          "fp": ca.repmat(fp, 1, len(group)), "g": ca.repmat(g, 1, len(group)),
                          "k": ca.repmat(scale, 1, len(group)),
                          "tau_mu": ca.DM([[cc.tau_mu for _, _, cc in group]]),

@@ -1,0 +1,266 @@
+"""A finger against the bird and the belt: continuation with contact events.
+
+What both finger models share (design/solve/contact/spatial_belt.py for the
+rod, planar_belt.py for the thesis's planar finger). A finger that can reach
+the belt is solved here; every other finger by its model's bird-only solver.
+The finger's state is one of six modes: ``free`` (straight, unloaded), the
+bird-only ``interior`` and ``tip``, and the belt modes ``belt``,
+``tip+belt`` and ``interior+belt``.
+
+From a solved state the bird, the belt and both friction laws are moved to
+their new values in steps that halve on failure and double on success
+(first the geometry under the old laws, then the laws, as the bird-only
+solvers do). After every step the contacts are checked:
+
+* a contact whose normal force would pull lets go;
+* the tip passing below the belt, or the finger entering the bird, starts a
+  contact;
+* the bird's contact point reaching the tip, or the tip turning tangent to
+  the bird, switches between interior and tip contact.
+
+A contact starts where it should, not a step late: the step is shortened
+until the crossing is within :data:`EVENT_DEPTH` (or the step within
+:data:`EVENT_STEP`), the mode is switched there and the solve repeated in
+the new mode. When the continued state cannot be followed (a fold), the
+finger is solved afresh from the straight finger, with the bird and the
+belt brought in from first touch.
+
+A point of the finger below the belt other than the tip (the finger lying
+on it) is outside the model: it is reported, not corrected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from design.solve.contact.robust import BASE_REACHED, MAX_STEP_ITERATIONS
+
+#: a contact event is located to within this penetration (m) ...
+EVENT_DEPTH = 1e-8
+#: ... or this fraction of the continuation step
+EVENT_STEP = 1e-6
+#: the finger's modes that touch the bird, and those that touch the belt
+BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
+BELT_MODES = ("belt", "tip+belt", "interior+belt")
+
+
+@dataclass(frozen=True)
+class Plane:
+    """The belt in a finger frame: n·r = e, n its upward unit normal (3,
+    spatial; (2,) in the planar finger's bending plane), e in m."""
+
+    normal: np.ndarray
+    offset: float
+
+    def level(self, pts: np.ndarray) -> np.ndarray:
+        """Height above the belt (m) of points (dim, n); < 0 below it."""
+        return self.normal @ pts - self.offset
+
+    @property
+    def params(self) -> np.ndarray:
+        return np.concatenate([self.normal, [self.offset]])
+
+    @staticmethod
+    def from_params(p: np.ndarray) -> "Plane":
+        n = np.asarray(p[:-1], float)
+        size = np.linalg.norm(n)
+        return Plane(n / size, float(p[-1]) / size)
+
+    def lowered_to(self, point: np.ndarray) -> "Plane":
+        """The same plane moved down, if need be, to just below ``point``."""
+        return Plane(self.normal, min(self.offset, float(self.normal @ point) - EVENT_DEPTH))
+
+
+@dataclass(frozen=True)
+class Belted:
+    """A finger's state against the bird and the belt: mode, unknowns (None
+    when ``free``), the bird's parameters in the model's form (None: out of
+    reach) and its friction's, the belt and its friction law's parameters,
+    and the post values (the model's belt layout; None when ``free``)."""
+
+    mode: str
+    z: np.ndarray | None
+    bird: np.ndarray | None
+    friction: np.ndarray
+    plane: Plane
+    belt: np.ndarray
+    post: np.ndarray | None = None
+    #: the share of the last friction change carried (below 1: sticking)
+    held: float = 1.0
+    #: planar: the side the bird bends the finger to (+1: towards +y)
+    side: int = 0
+
+
+class BeltedContact:
+    """The continuation of :class:`Belted` states; a finger model supplies the
+    equations and the geometry (the methods that raise NotImplementedError).
+
+    Attributes
+    ----------
+    length : float
+        The finger's length (m).
+    n_bird : int
+        The size of the bird's parameters.
+    max_steps : int
+    """
+
+    length: float
+    n_bird: int
+    max_steps: int = 400
+
+    def __init__(self):
+        self.newton_iterations = 0
+
+    def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
+        """The state at ``target``'s bird, belt and laws, continued from
+        ``previous`` (its mode and unknowns are ignored), else afresh; the
+        message says what happened on the way."""
+        self.newton_iterations = 0
+        state, msg = None, ""
+        if previous is not None and (target.bird is not None or previous.bird is None):
+            state, msg = self._follow(previous, target)
+        if state is not None:
+            return state, msg
+        fresh, msg2 = self._follow(self.free(target), target)
+        if fresh is None:
+            return None, msg2 if not msg else f"{msg}; afresh: {msg2}"
+        if previous is not None:
+            msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
+                  f"first touch" if msg else ""
+        return fresh, msg
+
+    def lowered(self, state: Belted) -> Belted:
+        """A solved bird-only state (mode, z, bird, friction, belt) with the
+        belt lowered to its tip: the belt then comes in from first touch."""
+        post = np.asarray(self.transcription(state.mode).post(state.z, self.q(state))[0]).ravel()
+        solved = self.solved(state, post)
+        plane = state.plane.lowered_to(self.tip(solved))
+        return self.solved(replace(solved, plane=plane), post)
+
+    # ------------------------------------------------------- continuation
+    def _params(self, state: Belted) -> np.ndarray:
+        bird = np.zeros(self.n_bird) if state.bird is None else state.bird
+        return np.concatenate([bird, state.friction, state.plane.params, state.belt])
+
+    def _moved(self, state: Belted, p: np.ndarray) -> Belted:
+        nb, nf, nd = self.n_bird, state.friction.size, state.plane.params.size
+        bird = None if state.bird is None else p[:nb]
+        return replace(state, bird=bird, friction=p[nb:nb + nf],
+                       plane=Plane.from_params(p[nb + nf:nb + nf + nd]), belt=p[nb + nf + nd:])
+
+    def _follow(self, state: Belted, target: Belted) -> tuple[Belted | None, str]:
+        """Continue ``state`` to ``target``: the geometry under the state's own
+        friction, then the friction (where the equilibrium ends before, a
+        fold, the contact sticks at the last one: ``held`` < 1)."""
+        if state.bird is None and target.bird is not None:
+            state = replace(state, bird=target.bird)
+        geometry = replace(state, bird=target.bird, plane=target.plane)
+        state, msg = self._path(state, self._params(geometry), exact=True)
+        if state is None:
+            return None, msg
+        laws = replace(state, friction=target.friction, belt=target.belt)
+        return self._path(state, self._params(laws), exact=False)
+
+    def _path(self, state: Belted, end: np.ndarray, exact: bool) -> tuple[Belted | None, str]:
+        """From ``state`` to the parameters ``end`` in adaptive steps, with
+        contact events. ``exact`` false: stop at the last equilibrium before
+        a fold (``held`` the share carried)."""
+        start = self._params(state)
+        if np.array_equal(start, end):
+            return state, ""
+        t, h = 0.0, 1.0
+        for _ in range(self.max_steps):
+            if t >= 1.0:
+                return replace(state, held=1.0), ""
+            t_new = min(1.0, t + h)
+            new = self._step(state, self._moved(state, start + t_new * (end - start)), h)
+            if isinstance(new, Belted):
+                state, t, h = new, t_new, min(2 * h, 1.0)
+                continue
+            if new == "base":
+                return None, BASE_REACHED
+            h /= 2
+            if h < 1e-7:
+                if exact:
+                    return None, f"continuation stalled at {t:.6f} of the step"
+                return replace(state, held=t), ""
+        return None, f"no convergence in {self.max_steps} continuation steps"
+
+    def _step(self, state: Belted, at: Belted, h: float):
+        """Solve at the parameters of ``at`` from ``state`` (a step of relative
+        size h): the new state; None (shorten the step: Newton failed, or a
+        contact starts inside it, to be located); ``base``."""
+        mode, z = state.mode, state.z
+        for _ in range(4):
+            new = self._newton(replace(at, mode=mode, z=z))
+            if new is None:
+                return None
+            event = self.event(new)
+            if event is None:
+                return new
+            kind, depth = event
+            if kind == "base":
+                return "base"
+            if depth > EVENT_DEPTH and h > EVENT_STEP and kind in ("bird", "belt"):
+                return None
+            switched = self.switch(new, kind)
+            if switched is None:
+                return None
+            mode, z = switched.mode, switched.z
+            at = replace(at, side=switched.side)
+        return None
+
+    def _newton(self, state: Belted) -> Belted | None:
+        """Newton in the state's mode at its parameters from its z; None when
+        it does not converge within MAX_STEP_ITERATIONS."""
+        if state.mode == "free":
+            return state
+        tr, q = self.transcription(state.mode), self.q(state)
+        rf = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)
+        z = np.asarray(rf(state.z, q)).ravel()
+        stats = rf.stats()
+        iterations = int(stats.get("iter_count", 0))
+        self.newton_iterations += iterations
+        post, resid = (np.asarray(v).ravel() for v in tr.post(z, q))
+        if not (stats.get("success", False) and np.isfinite(resid[0]) and resid[0] < 1e-8) \
+                or iterations > MAX_STEP_ITERATIONS:
+            return None
+        return self.solved(replace(state, z=z), post)
+
+    # --------------------------------------------------------- the model's
+    tolerance: float = 1e-12
+
+    def free(self, target: Belted) -> Belted:
+        """The straight finger with the bird and the belt moved back to first
+        touch (or left where they are if it misses them)."""
+        raise NotImplementedError
+
+    def transcription(self, mode: str):
+        raise NotImplementedError
+
+    def q(self, state: Belted) -> np.ndarray:
+        raise NotImplementedError
+
+    def solved(self, state: Belted, post: np.ndarray) -> Belted | None:
+        """A converged Newton solve's state with its post values in the belt
+        layout (None: the solve left the branch)."""
+        raise NotImplementedError
+
+    def tip(self, state: Belted) -> np.ndarray:
+        """The finger's tip in its frame (m)."""
+        raise NotImplementedError
+
+    def event(self, state: Belted) -> tuple[str, float] | None:
+        """The first thing wrong with a solved state and how far past its
+        crossing it is: a contact to end (``release-bird``,
+        ``release-belt``), to start (``bird``, ``belt``), a switch between
+        interior and tip (``to-tip``, ``to-interior``), the contact at the
+        base (``base``)."""
+        raise NotImplementedError
+
+    def switch(self, state: Belted, kind: str) -> Belted | None:
+        """The state in the mode after the event ``kind``, its unknowns mapped
+        (solved at the new parameters by the caller)."""
+        raise NotImplementedError

@@ -1,0 +1,254 @@
+"""A finger pressed on the moving belt, alone and with the bird (design/solve/
+contact/belt_continuation.py and its two finger models).
+
+References independent of the toolkit's collocation: the elastica with a
+unilateral tip constraint on a moving plane, solved by
+``scipy.integrate.solve_bvp``; the small-deflection closed form; for two
+loads, the elastica under the solved forces integrated by ``solve_bvp``.
+
+The setting (finger frame, clamped at the origin along +x): the belt's
+upward normal n = (-sin β, cos β) makes the finger point down into it at β;
+its straight tip would lie δ below the surface. The belt slides along its
+line at 0.3 m/s relative to the finger, so that its regularised Coulomb
+friction (ε = 0.02 m/s) is µN within 0.3 %.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_bvp
+
+from design.physics.beam import Finger
+from design.physics.kinematics import rot_x
+from design.physics.stiffness import UniformEI
+from design.solve.contact import RobustContact
+from design.solve.contact.belt_continuation import Belted, Plane
+from design.solve.contact.planar_belt import PlanarBeltContact
+from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact
+from design.solve.contact.spatial_belt import SpatialBeltContact
+from tests.problems import thesis_finger
+
+LENGTH = 0.152
+BETA = np.radians(15.0)
+NORMAL = np.array([-np.sin(BETA), np.cos(BETA)])
+LINE = np.array([np.cos(BETA), np.sin(BETA)])      # the belt's direction, tipwards
+MU, EPS, SLIDE = 0.4, 0.02, 0.3
+
+
+def belt_offset(depth: float) -> float:
+    """e of the belt n·p = e with the straight tip ``depth`` below it."""
+    return float(NORMAL @ np.array([LENGTH, 0.0])) + depth
+
+
+@lru_cache(maxsize=None)
+def solvers(kind: str):
+    """(planar, spatial) belt solvers of a finger: ``thesis`` (soft, non-uniform) or ``uniform``."""
+    finger = Finger(LENGTH, thesis_finger().stiffness) if kind == "thesis" else \
+        Finger(LENGTH, UniformEI(0.08))
+    planar = PlanarBeltContact(RobustContact(finger, MU, intervals=8))
+    spatial = SpatialBeltContact(SpatialContact(finger, intervals=8))
+    return finger, planar, spatial
+
+
+def planar_law(mu: float) -> np.ndarray:
+    """The finger slides tipwards over the belt at SLIDE (uniform in p)."""
+    return np.array([mu, EPS, *(SLIDE * LINE), 0.0, 0.0, 0.0, 0.0])
+
+
+def spatial_law(mu: float, turn: np.ndarray = np.eye(3)) -> FrictionLaw:
+    return FrictionLaw(mu=mu, speed=EPS, sliding_at_origin=turn @ np.array([*SLIDE * LINE, 0.0]))
+
+
+def solve_planar(kind: str, depth: float, mu: float):
+    _, planar, _ = solvers(kind)
+    sol, state = planar.solve(None, 0.0, Plane(NORMAL, belt_offset(depth)), planar_law(mu))
+    assert sol.converged and state.mode == "belt", sol.message
+    return sol.extras["belt_normal_force"], sol.extras["belt_point"]
+
+
+def solve_spatial(kind: str, depth: float, mu: float, turn: np.ndarray = np.eye(3)):
+    _, _, spatial = solvers(kind)
+    plane = Plane(turn @ np.array([*NORMAL, 0.0]), belt_offset(depth))
+    sol, state = spatial.solve(None, FrictionLaw(), plane, spatial_law(mu, turn))
+    assert sol.converged and state.mode == "belt", sol.message
+    return sol.belt_normal_force, sol.belt_point
+
+
+def reference(finger: Finger, depth: float, mu: float) -> tuple[float, np.ndarray]:
+    """The elastica with its tip on the belt: unknowns x, y, ψ, M over s and the
+    normal force N; the tip force N (n - µ w/sqrt(w² + ε²) t) with the
+    sliding w = SLIDE along t. solve_bvp at tol 1e-10."""
+    e = belt_offset(depth)
+    direction = NORMAL - mu * SLIDE / np.hypot(SLIDE, EPS) * LINE
+    ei = finger.stiffness.ei
+
+    def rhs(s, y, p):
+        fx, fy = p[0] * direction
+        return np.vstack([np.cos(y[2]), np.sin(y[2]), y[3] / ei(s),
+                          fx * np.sin(y[2]) - fy * np.cos(y[2])])
+
+    def bc(ya, yb, p):
+        return np.array([ya[0], ya[1], ya[2], yb[3], NORMAL @ yb[:2] - e])
+
+    s = np.linspace(0.0, LENGTH, 41)
+    guess = np.vstack([s, np.zeros_like(s), np.zeros_like(s), np.zeros_like(s)])
+    sol = solve_bvp(rhs, bc, s, guess, p=[0.0], tol=1e-10, max_nodes=100000)
+    assert sol.status == 0, sol.message
+    return float(sol.p[0]), sol.y[:2, -1]
+
+
+@pytest.mark.parametrize("depth", [2e-3, 7.3e-3, 3e-2])
+@pytest.mark.parametrize("mu", [0.0, MU])
+def test_both_finger_models_press_on_the_belt_as_the_elastica_does(depth, mu):
+    """The thesis's finger (soft, non-uniform) 2, 7.3 (finger 5 of Table 5-1)
+    and 30 mm below the belt, with and without friction: the normal force
+    within 1e-6 relative and the tip within 1e-7 m of solve_bvp's (both
+    solutions resolve the elastica to ~1e-9); the spatial rod, loaded in its
+    plane, gives the planar finger's answer."""
+    finger, _, _ = solvers("thesis")
+    force, tip = reference(finger, depth, mu)
+    for model in (solve_planar, solve_spatial):
+        f, p = model("thesis", depth, mu)
+        assert f == pytest.approx(force, rel=1e-6)
+        np.testing.assert_allclose(p[:2], tip, atol=1e-7)
+
+
+@pytest.mark.parametrize("mu, sense", [(0.0, 0), (MU, 1)])
+def test_a_shallow_press_follows_the_small_deflection_closed_form(mu, sense):
+    """δ = 0.1 mm on a uniform finger: the tip deflects δ / cos β across the
+    finger, so the transverse force 3 EI δ / (l³ cos β) balances N (cos β -
+    µ sin β) (friction on the finger against its tipward sliding). Within
+    1e-3: the beam-column and large-deflection corrections are O(δ / l) and
+    O(F l² / EI) ~ 1e-4 here."""
+    depth = 1e-4
+    closed = 3 * 0.08 * depth / (LENGTH ** 3 * np.cos(BETA)) / \
+        (np.cos(BETA) - sense * mu * np.sin(BETA))
+    for model in (solve_planar, solve_spatial):
+        assert model("uniform", depth, mu)[0] == pytest.approx(closed, rel=1e-3)
+
+
+@pytest.mark.parametrize("angle", [0.7, -1.9])
+def test_a_round_finger_presses_the_same_whichever_way_the_belt_lies_about_it(angle):
+    """Turning belt and sliding about the axis of a round uniform finger turns
+    the solution with them: the same normal force, the tip turned (to 1e-8
+    relative)."""
+    turn = rot_x(angle)
+    force, tip = solve_spatial("uniform", 7.3e-3, MU)
+    f, p = solve_spatial("uniform", 7.3e-3, MU, turn)
+    assert f == pytest.approx(force, rel=1e-8)
+    np.testing.assert_allclose(p, turn @ tip, atol=1e-9)
+
+
+def pressing_sweep(model: str):
+    """A bird (ellipse/ellipsoid of semi-axes 50 and 40 mm, 60 mm deep) lowered
+    onto the thesis finger resting 7.3 mm deep on the belt, then raised
+    again, frictionless: the states along the way."""
+    _, planar, spatial = solvers("thesis")
+    heights = np.concatenate([np.linspace(0.07, 0.04, 13), np.linspace(0.04, 0.07, 13)[1:]])
+    plane = belt_offset(7.3e-3)
+    out, state = [], None
+    for yc in heights:
+        if model == "planar":
+            conic = (np.array([0.10, yc]), np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2]))
+            sol, state = planar.solve(conic, 0.0, Plane(NORMAL, plane), planar_law(0.0), state)
+            belt = sol.extras["belt_normal_force"]
+        else:
+            quadric = Quadric(np.array([0.10, yc, 0.0]),
+                              np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
+            sol, state = spatial.solve(quadric, FrictionLaw(),
+                                       Plane(np.array([*NORMAL, 0.0]), plane), spatial_law(0.0),
+                                       state)
+            belt = sol.belt_normal_force
+        assert sol.converged, sol.message
+        out.append((yc, state, sol, belt))
+    return out
+
+
+@pytest.mark.parametrize("model", ["planar", "spatial"])
+def test_the_bird_pressing_a_finger_on_the_belt_starts_and_ends_its_contact_where_it_touches(
+        model):
+    """Lowering the bird onto the finger on the belt: belt alone, then the bird
+    inside the span with the tip on the belt, the belt's force rising with the
+    bird's; raising it again retraces the same states (frictionless: no
+    hysteresis) back to the belt alone."""
+    sweep = pressing_sweep(model)
+    modes = [s.mode for _, s, _, _ in sweep]
+    assert modes[0] == modes[-1] == "belt"
+    assert "interior+belt" in modes
+    down, up = sweep[:13], sweep[12:][::-1]
+    for (_, s1, sol1, b1), (_, s2, sol2, b2) in zip(down, up):
+        assert s1.mode == s2.mode
+        assert b1 == pytest.approx(b2, rel=1e-6, abs=1e-9)
+    touching = [(sol.normal_force if model == "spatial" else sol.force, b)
+                for _, s, sol, b in down if s.mode == "interior+belt"]
+    assert all(b2 > b1 for (_, b1), (_, b2) in zip(touching, touching[1:]))
+
+
+def two_load_reference(finger: Finger, arc: float, f_bird: np.ndarray, f_belt: np.ndarray):
+    """The planar elastica under a force f_bird at arc length ``arc`` and f_belt
+    at the tip (forces on the finger, N), by solve_bvp on [0, l] with the
+    internal force jumping at ``arc`` (two stacked intervals)."""
+    ei = finger.stiffness.ei
+
+    def rhs(u, y):
+        # y: x, y, ψ, M on [0, arc] (first 4) and on [arc, l] (last 4), u in [0, 1]
+        out = []
+        for k, (start, span, force) in enumerate(((0.0, arc, f_bird + f_belt),
+                                                  (arc, LENGTH - arc, f_belt))):
+            x, yy, psi, m = y[4 * k:4 * k + 4]
+            out += [span * np.cos(psi), span * np.sin(psi), span * m / ei(start + span * u),
+                    span * (force[0] * np.sin(psi) - force[1] * np.cos(psi))]
+        return np.vstack(out)
+
+    def bc(ya, yb):
+        return np.array([ya[0], ya[1], ya[2], *(yb[:4] - ya[4:]), yb[7]])
+
+    u = np.linspace(0.0, 1.0, 41)
+    sol = solve_bvp(rhs, bc, u, np.zeros((8, u.size)), tol=1e-10, max_nodes=100000)
+    assert sol.status == 0, sol.message
+    return sol.y[:2, -1], sol.y[4:6, -1]
+
+
+def test_two_segments_bend_as_the_elastica_under_both_forces():
+    """At the deepest state of the planar sweep (bird inside the span, tip on
+    the belt): the elastica under the two solved forces, integrated by
+    solve_bvp, puts the bird's contact point and the tip where the toolkit's
+    two collocated segments do (1e-7 m), and the contact conditions hold:
+    the point on the bird's ellipse, the tip on the belt (1e-9)."""
+    finger, planar, _ = solvers("thesis")
+    yc, state, sol, _ = pressing_sweep("planar")[12]
+    assert state.mode == "interior+belt"
+    f_bird = -sol.force_on_object_finger_frame
+    f_belt = -sol.extras["belt_force"]
+    point, tip = two_load_reference(finger, sol.arc_length, f_bird, f_belt)
+    np.testing.assert_allclose(sol.point, point, atol=1e-7)
+    np.testing.assert_allclose(sol.extras["belt_point"], tip, atol=1e-7)
+    d = np.asarray(sol.point) - np.array([0.10, yc])
+    assert (d[0] / 0.05) ** 2 + (d[1] / 0.04) ** 2 == pytest.approx(1.0, abs=1e-9)
+    assert NORMAL @ sol.extras["belt_point"] == pytest.approx(belt_offset(7.3e-3), abs=1e-9)
+
+
+def test_a_finger_clear_of_the_belt_is_left_alone():
+    """A belt below the straight tip: no contact, no force, the straight finger."""
+    _, planar, spatial = solvers("thesis")
+    sol, state = spatial.solve(None, FrictionLaw(), Plane(np.array([*NORMAL, 0.0]),
+                                                           belt_offset(-1e-3)), spatial_law(MU))
+    assert state.mode == "free" and sol.belt_normal_force == 0.0 and sol.below_belt == 0.0
+    sol, state = planar.solve(None, 0.0, Plane(NORMAL, belt_offset(-1e-3)), planar_law(MU))
+    assert state.mode == "free" and sol.extras["belt_normal_force"] == 0.0
+
+
+def test_a_continued_state_is_the_fresh_one():
+    """Continuing the finger on the belt from a neighbouring belt position or
+    solving it afresh gives the same state (1e-10 relative)."""
+    _, _, spatial = solvers("thesis")
+    plane = Plane(np.array([*NORMAL, 0.0]), belt_offset(7.3e-3))
+    _, near = spatial.solve(None, FrictionLaw(), Plane(plane.normal, belt_offset(6e-3)),
+                            spatial_law(MU))
+    continued, _ = spatial.solve(None, FrictionLaw(), plane, spatial_law(MU), near)
+    fresh, _ = spatial.solve(None, FrictionLaw(), plane, spatial_law(MU))
+    assert isinstance(near, Belted)
+    assert continued.belt_normal_force == pytest.approx(fresh.belt_normal_force, rel=1e-10)
