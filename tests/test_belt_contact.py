@@ -66,7 +66,7 @@ def solve_planar(kind: str, depth: float, mu: float):
     _, planar, _ = solvers(kind)
     sol, state = planar.solve(None, 0.0, Plane(NORMAL, belt_offset(depth)), planar_law(mu))
     assert sol.converged and state.mode == "belt", sol.message
-    return sol.extras["belt_normal_force"], sol.extras["belt_point"]
+    return sol.belt_normal_force, sol.belt_point
 
 
 def solve_spatial(kind: str, depth: float, mu: float, turn: np.ndarray = np.eye(3)):
@@ -154,7 +154,7 @@ def pressing_sweep(model: str):
         if model == "planar":
             conic = (np.array([0.10, yc]), np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2]))
             sol, state = planar.solve(conic, 0.0, Plane(NORMAL, plane), planar_law(0.0), state)
-            belt = sol.extras["belt_normal_force"]
+            belt = sol.belt_normal_force
         else:
             quadric = Quadric(np.array([0.10, yc, 0.0]),
                               np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
@@ -222,13 +222,13 @@ def test_two_segments_bend_as_the_elastica_under_both_forces():
     yc, state, sol, _ = pressing_sweep("planar")[12]
     assert state.mode == "interior+belt"
     f_bird = -sol.force_on_object_finger_frame
-    f_belt = -sol.extras["belt_force"]
+    f_belt = -sol.belt_force
     point, tip = two_load_reference(finger, sol.arc_length, f_bird, f_belt)
     np.testing.assert_allclose(sol.point, point, atol=1e-7)
-    np.testing.assert_allclose(sol.extras["belt_point"], tip, atol=1e-7)
+    np.testing.assert_allclose(sol.belt_point, tip, atol=1e-7)
     d = np.asarray(sol.point) - np.array([0.10, yc])
     assert (d[0] / 0.05) ** 2 + (d[1] / 0.04) ** 2 == pytest.approx(1.0, abs=1e-9)
-    assert NORMAL @ sol.extras["belt_point"] == pytest.approx(belt_offset(7.3e-3), abs=1e-9)
+    assert NORMAL @ sol.belt_point == pytest.approx(belt_offset(7.3e-3), abs=1e-9)
 
 
 def test_a_finger_clear_of_the_belt_is_left_alone():
@@ -238,7 +238,7 @@ def test_a_finger_clear_of_the_belt_is_left_alone():
                                                            belt_offset(-1e-3)), spatial_law(MU))
     assert state.mode == "free" and sol.belt_normal_force == 0.0 and sol.below_belt == 0.0
     sol, state = planar.solve(None, 0.0, Plane(NORMAL, belt_offset(-1e-3)), planar_law(MU))
-    assert state.mode == "free" and sol.extras["belt_normal_force"] == 0.0
+    assert state.mode == "free" and sol.belt_normal_force == 0.0
 
 
 def test_a_continued_state_is_the_fresh_one():

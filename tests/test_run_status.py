@@ -131,3 +131,29 @@ def test_a_pareto_run_reports_its_worst_cap():
         (NO_IMPROVEMENT, "no improvement found at 20.0")
     assert overall_status([entry(VERIFIED, 20.0), entry(FAILED, 30.0),
                            entry(ERROR, 40.0)]) == (ERROR, "cap 40.00 N: error at 40.0")
+
+
+def test_a_claim_the_optimiser_cannot_evaluate_fails_verification_with_a_report(
+        problem, monkeypatch, capsys):
+    """A design off the baseline whose fixed-design NLP does not converge has
+    no claim (NaN): the run ends 'failed verification' (exit 1) with its
+    report, result.json writing the claim as null, not a traceback."""
+    from design.solve.optimize.trust_region import Outcome, score
+
+    def moved(population, caps, settings, rules, start, progress, anchor=True):
+        d0 = population.space.scale(population.space.base_values)
+        return Outcome(score(population, d0 + 0.1, settings), score(population, d0, settings),
+                       caps)
+
+    monkeypatch.setattr("design.run.solve.optimise", moved)
+    monkeypatch.setattr("design.solve.optimize.trust_region.optimiser_views",
+                        lambda *args, **kwargs: ([None], "the fixed-design NLP failed: stalled"))
+    code, result, last, stderr, report, out = solve(problem, capsys)
+    assert code == 1
+    assert result["status"] == FAILED
+    assert result["message"].startswith("the optimiser could not evaluate its own design")
+    assert result["objective"]["hold_time_s"] is None
+    assert result["verification"]["hold_time_relative_difference"] is None
+    assert not result["verification"]["passed"]
+    assert "optimiser not evaluated" in last and "FAILED: failed verification" in stderr
+    assert '<div class="banner failed" id="verdict">FAILED VERIFICATION: the optimiser' in report

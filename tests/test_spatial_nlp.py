@@ -60,7 +60,7 @@ def stage_inputs(setup, record, i: int) -> dict:
     fp = [v[key + "angle"] + gf.phase, v[key + "height"], gf.mount.radius, v[key + "phi_x"],
           v[key + "phi_y"], v[key + "length"]]
     return {"state": record.y, "t": record.t, "fp": fp, "g": [v["spacing"], v["drum_speed"]],
-            "k": 1.0, "z0": record.fingers[i].solution.extras["z"]}
+            "k": 1.0, "belt": record.belt_speed, "z0": record.fingers[i].solution.extras["z"]}
 
 
 @pytest.fixture(scope="module")
@@ -87,7 +87,7 @@ def test_the_nlp_finger_is_the_simulators(finger_4a):
     friction law is the same forward difference of the same frames."""
     load, inputs, state, _ = finger_4a
     mode = state.solution.extras["mode"]
-    out, force, z = load.functions[mode](*(inputs[n] for n in load.inputs))
+    out, force, z = load.function(mode)(*(inputs[n] for n in load.inputs))
     z_sim = inputs["z0"]
     assert np.abs(np.asarray(z).ravel() - z_sim).max() <= 1e-9 * np.abs(z_sim).max()
     assert state.magnitude > 5.0
@@ -108,7 +108,7 @@ def test_the_spatial_jacobian_is_the_rootfinders_derivative(finger_4a, monkeypat
     from design.solve.optimize.finger_load import SpatialStage, StageFunctions
     load, inputs, state, _ = finger_4a
     mode = state.solution.extras["mode"]
-    F = load.functions[mode]
+    F = load.function(mode)
     sizes = SpatialStage.sizes
     st = StageFunctions(load.transcriptions[mode], load.constants.size, SpatialStage)
     x = ca.MX.sym("x", sum(sizes.values()))
@@ -159,8 +159,8 @@ def test_the_nlp_calls_the_spatial_finger_with_each_nodes_state(monkeypatch):
                               v[key + "phi_x"], v[key + "phi_y"], v[key + "length"]]
                         inputs = {"state": phase.states[k], "t": t_phase + k * h, "fp": fp,
                                   "g": [v["spacing"], v["drum_speed"]], "k": 1.0,
-                                  "z0": contact.z}
-                        _, force, _ = load.functions[contact.mode](
+                                  "belt": nlp.setup.conveyor.speed, "z0": contact.z}
+                        _, force, _ = load.function(contact.mode)(
                             *(inputs[name] for name in load.inputs))
                         assert forces[n] == pytest.approx(float(force), rel=1e-12, abs=1e-12)
                         checked += 1

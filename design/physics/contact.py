@@ -91,6 +91,14 @@ class ContactSolution:
     message: str = ""
     penetration: float = 0.0
     extras: dict = field(default_factory=dict)
+    #: the finger's force on the belt in its plane (N, finger frame; None: not
+    #: on the belt), its normal part, the tip where it acts, and how far the
+    #: finger's deepest point lies below the belt (m) (design/solve/contact/
+    #: planar_belt.py)
+    belt_force: np.ndarray | None = None
+    belt_normal_force: float = 0.0
+    belt_point: np.ndarray | None = None
+    below_belt: float = 0.0
 
     @property
     def force_on_object_finger_frame(self) -> np.ndarray:

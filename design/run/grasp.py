@@ -81,17 +81,18 @@ def result_dict(scene: GraspScene, r: GraspRun) -> dict:
 
 
 def summary_line(result: dict) -> str:
-    """The command's closing line for a grasp run that finished: the hold, the
-    peak, how high the bird went, and the model's validity problems (units
-    s, N, mm, deg)."""
+    """The command's closing line for a grasp run that finished: the hold, a
+    jam, the peak, how high the bird went, and the model's validity problems
+    (units s, N, mm, deg)."""
     s = result["summary"]
     problems = validity_problems(s["validity"])
     caveat = " (by a model outside its validity)" if problems else ""
     peak = (f"peak finger force {s['max_finger_force_N']:.2f} N at "
             f"{s['max_finger_force_finger']} (t = {s['max_finger_force_time_s']:.3f} s)"
             if s["max_finger_force_N"] > 0 else "no finger touched the bird")
-    line = (f"finished{caveat}: hold {s['hold_time_s']:.4f} s (longest N = 0 window; "
-            f"{s['total_hold_s']:.4f} s in all), {peak}, centre rise "
+    jammed = f"; JAMMED: {'; '.join(s['jam'])}" if s["jam"] else ""
+    line = (f"finished{caveat}: hold {s['hold_time_s']:.4f} s (longest N = 0 window the bird "
+            f"is put back from; {s['total_hold_s']:.4f} s in all){jammed}, {peak}, centre rise "
             f"{1e3 * s['centre_rise_m']:.1f} mm, belt clearance "
             f"{1e3 * s['belt_clearance_m']:.1f} mm, pitch up to "
             f"{np.degrees(s['max_pitch_rad']):.1f} deg")

@@ -35,6 +35,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from design.solve.buffers import Buffered
 from design.solve.contact.robust import BASE_REACHED, MAX_STEP_ITERATIONS
 
 #: a contact event is located to within this penetration (m) ...
@@ -111,7 +112,9 @@ class BeltedContact:
     max_steps: int = 400
 
     def __init__(self):
+        #: Newton solves of the last :meth:`continued`
         self.newton_iterations = 0
+        self._calls: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
         """The state at ``target``'s bird, belt and laws, continued from
@@ -134,7 +137,7 @@ class BeltedContact:
     def lowered(self, state: Belted) -> Belted:
         """A solved bird-only state (mode, z, bird, friction, belt) with the
         belt lowered to its tip: the belt then comes in from first touch."""
-        post = np.asarray(self.transcription(state.mode).post(state.z, self.q(state))[0]).ravel()
+        post = self.calls(state.mode)[1](state.z, self.q(state))[0].ravel()
         solved = self.solved(state, post)
         plane = state.plane.lowered_to(self.tip(solved))
         return self.solved(replace(solved, plane=plane), post)
@@ -151,11 +154,17 @@ class BeltedContact:
                        plane=Plane.from_params(p[nb + nf:nb + nf + nd]), belt=p[nb + nf + nd:])
 
     def _follow(self, state: Belted, target: Belted) -> tuple[Belted | None, str]:
-        """Continue ``state`` to ``target``: the geometry under the state's own
+        """Continue ``state`` to ``target``: the usual short step, geometry and
+        friction in one solve; else the geometry under the state's own
         friction, then the friction (where the equilibrium ends before, a
         fold, the contact sticks at the last one: ``held`` < 1)."""
         if state.bird is None and target.bird is not None:
             state = replace(state, bird=target.bird)
+        whole = replace(state, bird=target.bird, plane=target.plane, friction=target.friction,
+                        belt=target.belt)
+        new = self._step(state, whole, 1.0)
+        if isinstance(new, Belted):
+            return replace(new, held=1.0), ""
         geometry = replace(state, bird=target.bird, plane=target.plane)
         state, msg = self._path(state, self._params(geometry), exact=True)
         if state is None:
@@ -217,17 +226,24 @@ class BeltedContact:
         it does not converge within MAX_STEP_ITERATIONS."""
         if state.mode == "free":
             return state
-        tr, q = self.transcription(state.mode), self.q(state)
-        rf = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)
-        z = np.asarray(rf(state.z, q)).ravel()
-        stats = rf.stats()
-        iterations = int(stats.get("iter_count", 0))
-        self.newton_iterations += iterations
-        post, resid = (np.asarray(v).ravel() for v in tr.post(z, q))
-        if not (stats.get("success", False) and np.isfinite(resid[0]) and resid[0] < 1e-8) \
-                or iterations > MAX_STEP_ITERATIONS:
+        newton, post = self.calls(state.mode)[:2]
+        q = self.q(state)
+        z = newton(state.z, q)[0].ravel()
+        self.newton_iterations += 1
+        post, resid = (v.ravel() for v in post(z, q))
+        if not (np.isfinite(resid[0]) and resid[0] < 1e-8):
             return None
         return self.solved(replace(state, z=z), post)
+
+    def calls(self, mode: str) -> tuple[Buffered, Buffered, Buffered]:
+        """A mode's Newton solve (z0, q) -> z (at most MAX_STEP_ITERATIONS
+        iterations), post values and the finger's shape, called through
+        buffers (design/solve/buffers.py)."""
+        if mode not in self._calls:
+            tr = self.transcription(mode)
+            self._calls[mode] = (Buffered(tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)),
+                                 Buffered(tr.post), Buffered(tr.shape))
+        return self._calls[mode]
 
     # --------------------------------------------------------- the model's
     tolerance: float = 1e-12

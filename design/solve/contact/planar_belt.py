@@ -25,7 +25,7 @@ from design.solve.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belt
                                                     BeltedContact, Plane)
 from design.solve.contact.planar_belt_equations import (POST_BELT_FORCE, POST_BELT_ON_FINGER,
                                                         POST_TIP, planar_belt_transcription)
-from design.solve.contact.robust import BASE_FRACTION, RobustContact
+from design.solve.contact.robust import BASE_FRACTION, RobustContact, _State
 from design.solve.contact.spatial_belt import _evaluate, _nodes
 from design.solve.contact.spatial_belt_equations import overhang_widths
 
@@ -88,6 +88,13 @@ class PlanarBeltContact(BeltedContact):
         return self.lowered(Belted(state.mode, state.z, bird, np.array([state.tau_mu]), line,
                                    np.asarray(belt, float), side=state.side))
 
+    def bird_only(self, state: Belted):
+        """A state off the belt as :class:`RobustContact`'s (None when free)."""
+        if state.mode not in ("interior", "tip"):
+            return None
+        return _State(state.mode, state.z, None, float(state.friction[0]), state.side,
+                      state.post[:12], (state.bird[:2].copy(), _matrix(state.bird)))
+
     # --------------------------------------------------------- the model's
     def free(self, target: Belted) -> Belted:
         bird, side = target.bird, 0
@@ -120,7 +127,7 @@ class PlanarBeltContact(BeltedContact):
                 k = self._kappa_index(mode)
                 z[k], z[k + 1] = -z[k], z[k + 1] + np.pi
                 state = replace(state, z=z)
-                post = np.asarray(self.transcription(mode).post(z, self.q(state))[0]).ravel()
+                post = self.calls(mode)[1](z, self.q(state))[0].ravel()
             if state.side * post[11] <= 0:        # bent the other way: another branch
                 return None
         if mode in BELT_MODES:
@@ -226,11 +233,10 @@ class PlanarBeltContact(BeltedContact):
         """The finger's points (2, n), base to tip."""
         if state.mode == "free":
             return np.vstack([np.linspace(0.0, self.length, 16), np.zeros(16)])
-        q = self.q(state)
+        shape = self.calls(state.mode)[2](state.z, self.q(state))
         if state.mode in BELT_MODES:
-            return np.asarray(self.tr[state.mode].shape(state.z, q))
-        _, x, y, _, _ = (np.asarray(v).ravel() for v in
-                         self.contact._conic[state.mode].shape(state.z, q))
+            return shape[0]
+        x, y = shape[1].ravel(), shape[2].ravel()
         post = state.post
         rest = np.linspace(0.0, self.length - post[5], 6)[1:]
         t_f = np.array([np.cos(post[2]), np.sin(post[2])])
@@ -315,26 +321,22 @@ class PlanarBeltContact(BeltedContact):
                                message=message)
 
     def _solution(self, state: Belted, msg: str, detail: bool) -> ContactSolution:
-        """The state as a :class:`ContactSolution` with the belt's part (in
-        ``extras``: the finger's force on the belt in its plane (2,), N; its
-        normal part; the tip where it acts; how far the finger lies below the
-        belt, m)."""
+        """The state as a :class:`ContactSolution` with the belt's part."""
         mode, post = state.mode, state.post
         pts = self._points(state) if detail else np.array([[0.0, self.tip(state)[0]],
                                                            [0.0, self.tip(state)[1]]])
         extras = {"mode": mode, "z": None if state.z is None else state.z.copy(),
-                  "friction_ratio": float(state.friction[0]),
-                  "below_belt": float(max(0.0, -state.plane.level(pts).min())) if detail
-                  else 0.0,
-                  "belt_force": -post[POST_BELT_ON_FINGER] if mode in BELT_MODES else None,
-                  "belt_normal_force": float(post[POST_BELT_FORCE]) if mode in BELT_MODES
-                  else 0.0,
-                  "belt_point": post[POST_TIP].copy() if mode in BELT_MODES else None}
+                  "friction_ratio": float(state.friction[0])}
+        on = mode in BELT_MODES
+        belt = {"below_belt": float(max(0.0, -state.plane.level(pts).min())) if detail else 0.0,
+                "belt_force": -post[POST_BELT_ON_FINGER] if on else None,
+                "belt_normal_force": float(post[POST_BELT_FORCE]) if on else 0.0,
+                "belt_point": post[POST_TIP].copy() if on else None}
         s = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=1)))])
         if mode not in BIRD_MODES:
             return ContactSolution(False, 0.0, 0.0, 0.0, (np.nan, np.nan), 0.0, False, None,
                                    "none", FingerPose(0.0, 0.0), s, pts[0], pts[1], True,
-                                   self.newton_iterations, msg, extras=extras)
+                                   self.newton_iterations, msg, extras=extras, **belt)
         tau_mu = float(state.friction[0])
         label = "none" if tau_mu == 0.0 else ("tipward" if tau_mu > 0 else "baseward")
         return ContactSolution(
@@ -342,7 +344,7 @@ class PlanarBeltContact(BeltedContact):
                                                                    float(post[1])),
             float(post[2]), mode.startswith("tip"), "push" if state.side > 0 else "pull", label,
             FingerPose(0.0, 0.0), s, pts[0], pts[1], True, self.newton_iterations, msg,
-            0.0 if detail else float("nan"), extras=extras)
+            0.0 if detail else float("nan"), extras=extras, **belt)
 
 
 def _matrix(bird: np.ndarray) -> np.ndarray:

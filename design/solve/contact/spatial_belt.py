@@ -77,6 +77,13 @@ class SpatialBeltContact(BeltedContact):
         return self.lowered(Belted(state.mode, state.z, state.quadric.params, state.friction,
                                    plane, FrictionLaw.of(belt).params))
 
+    def bird_only(self, state: Belted) -> SpatialState | None:
+        """A state off the belt as :class:`SpatialContact`'s (None when free)."""
+        if state.mode not in ("interior", "tip"):
+            return None
+        return SpatialState(state.mode, state.z, Quadric.from_params(state.bird), state.friction,
+                            state.post[:19])
+
     # --------------------------------------------------------- the model's
     def free(self, target: Belted) -> Belted:
         bird = target.bird
@@ -190,10 +197,10 @@ class SpatialBeltContact(BeltedContact):
         """The finger's points (3, n), base to tip."""
         if state.mode == "free":
             return np.vstack([np.linspace(0.0, self.length, 16), np.zeros((2, 16))])
-        q = self.q(state)
+        shape = self.calls(state.mode)[2](state.z, self.q(state))
         if state.mode in BELT_MODES:
-            return np.asarray(self.tr[state.mode].shape(state.z, q))
-        _, r, _ = (np.asarray(v) for v in self.contact.tr[state.mode].shape(state.z, q))
+            return shape[0]
+        r = shape[1]
         post = state.post
         rest = np.linspace(0.0, self.length - post[4], 6)[1:]
         return np.hstack([r, post[:3, None] + post[13:16, None] * rest[None, :]])

@@ -51,7 +51,7 @@ from design.physics.kinematics import Ellipsoid
 from design.solve.contact import RobustContact
 from design.solve.contact.spatial import (FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, SpatialState, segment_level)
-from design.solve.contact.belt_continuation import BIRD_MODES, Belted, Plane
+from design.solve.contact.belt_continuation import BELT_MODES, BIRD_MODES, Belted, Plane
 from design.solve.contact.planar_belt import PlanarBeltContact
 from design.solve.contact.spatial_belt import SpatialBeltContact
 
@@ -204,8 +204,10 @@ class PlanarFinger:
         (:meth:`_line`)."""
         line = self._line(belt)
         length = self.solver.finger.length
-        if line is not None and (isinstance(start, Belted) or
-                                 line[0].level(np.array([[length], [0.0]]))[0] < 0.0):
+        resting = line is not None and line[0].level(np.array([[length], [0.0]]))[0] < 0.0
+        if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
+            start = self.belted.bird_only(start)         # off the belt: the bird-only solver
+        if line is not None and (isinstance(start, Belted) or resting):
             return self._belted_solve(body, base, R, kin_factory,
                                       start if isinstance(start, Belted) else None, commit, line)
         start = None if isinstance(start, Belted) else start
@@ -343,6 +345,8 @@ class SpatialFinger:
         misses = segment_level(quadric, self.solver.finger.length) >= 0.0
         resting = belt is not None and belt[0].level(
             np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
+            start = self.belted.bird_only(start)         # off the belt: the bird-only solver
         if belt is not None and (resting or isinstance(start, Belted)):
             return self._belted_solve(body, quadric, base, R, kin_factory,
                                       start if isinstance(start, Belted) else None, commit, belt)
@@ -428,9 +432,9 @@ def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length,
     bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
     1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
     For n fingers at once: base and axis (n, 3), length (n,); returns (n,).
-    ``grow`` (m): the bird with every semi-axis that much longer (it then
-    holds every point within ``grow`` of the bird)."""
-    scale = 1.0 / (np.array([body.eta, body.lam, body.gamma]) + grow)
+    ``grow`` (m; one value or one per finger): the bird with every semi-axis
+    that much longer (it then holds every point within ``grow`` of the bird)."""
+    scale = 1.0 / (np.array([body.eta, body.lam, body.gamma]) + np.asarray(grow)[..., None])
     p = scale * ((base - np.asarray(body.center)) @ body.rotation)
     e = scale * (axis @ body.rotation)
     x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
@@ -526,12 +530,11 @@ class FingerForces:
         depth = -tips[:, 2]
         resting = (depth > 0) & np.array([self.belt.touches(self.grasper.fingers[i].design_name,
                                                            tip[1]) for i, tip in zip(inside, tips)])
-        if commit:
-            return out | set(inside[resting].tolist())
-        for k in np.flatnonzero(resting):
-            if straight_level(body, bases[inside[k]], axes[k], lengths[k], grow=depth[k]) <= MISSES:
-                out.add(int(inside[k]))
-        return out
+        if commit or not np.any(resting):
+            return out | set(inside[resting].tolist()) if commit else out
+        near = straight_level(body, bases[inside[resting]], axes[resting], lengths[resting],
+                              grow=depth[resting]) <= MISSES
+        return out | set(inside[resting][near].tolist())
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the

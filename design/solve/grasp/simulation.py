@@ -123,7 +123,8 @@ def _union(a, b):
 def hold_windows(run: GraspRun) -> list[tuple[float, float]]:
     """Intervals (s) in which the belt does not support the bird (N = 0). A
     touch-down ends a window even when the bird bounces straight off: the
-    belt's impulse carried it at that instant."""
+    belt's impulse carried it at that instant. The last window may run to
+    the end of the run (the bird not yet put back)."""
     recs = run.trajectory.records
     impacts = {t for t, name in run.trajectory.events if name == "touch-down"}
     out, start = [], None
@@ -141,6 +142,27 @@ def hold_windows(run: GraspRun) -> list[tuple[float, float]]:
     return out
 
 
+def jam(run: GraspRun, validity: dict) -> list[str]:
+    """Why the grasp is a jam, not a hold (empty: it is not): the bird still
+    held off the belt when the run ends, not carried on downstream (moving
+    back or at rest on the belt at the end), or a finger past its fold force
+    while it carried the bird (design/solve/grasp/validity.py)."""
+    last = run.trajectory.records[-1]
+    names = [gf.name for gf in run.setup.grasper.fingers]
+    out = []
+    if last.mode == "air":
+        holding = [n for n, f in zip(names, last.fingers) if f.magnitude > 0]
+        out.append(f"the bird is still held off the belt when the run ends at {last.t:.3f} s"
+                   + (f" (by {', '.join(holding)})" if holding else ""))
+    elif last.y[3] <= 0.0:
+        out.append(f"the bird is not carried on: it moves at {last.y[3]:+.3f} m/s along the "
+                   f"belt when the run ends")
+    out += [f"finger {b['finger']} pressed {b['force_N']:.1f} N, past its fold force "
+            f"{b['fold_force_N']:.1f} N, at {b['time_s']:.3f} s"
+            for b in validity["forces_beyond_fold"]]
+    return out
+
+
 def summarise(run: GraspRun) -> dict:
     recs = run.trajectory.records
     windows = hold_windows(run)
@@ -152,10 +174,18 @@ def summarise(run: GraspRun) -> dict:
     gap = z - np.array([BirdDynamics(run.setup.bird, run.setup.legs, 0.0).support(r.y[2])[1]
                         for r in recs])
     validity = contact_validity(run, peak, when)
+    jammed = jam(run, validity)
+    # a window counts as a hold only if the bird is put back on the belt after it
+    # and carried on: not one still open when the run ends, none if the bird stays
+    released = [(a, b) for a, b in windows if b < recs[-1].t]
+    carried = recs[-1].mode != "air" and recs[-1].y[3] > 0.0
+    counted = released if carried else []
     return {
         "hold_windows": [[a, b] for a, b in windows],
-        "hold_time_s": max((b - a for a, b in windows), default=0.0),
-        "total_hold_s": sum(b - a for a, b in windows),
+        "hold_time_s": max((b - a for a, b in counted), default=0.0),
+        "total_hold_s": sum(b - a for a, b in counted),
+        "jammed": bool(jammed),
+        "jam": jammed,
         "max_finger_force_N": float(peak[j]),
         "max_finger_force_finger": names[j],
         "max_finger_force_time_s": float(when[j]),

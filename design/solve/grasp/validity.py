@@ -55,6 +55,11 @@ def fold_force(finger: Finger) -> float:
     return float(brentq(slope, hi / 2 if slope(hi / 2) < 0 else 0.0, hi, xtol=1e-3 * hi))
 
 
+def finger_limits(setup, cap: float) -> np.ndarray:
+    """Each finger's force limit (N): the cap or its fold force, the lower."""
+    return np.array([min(cap, fold_force(gf.finger)) for gf in setup.grasper.fingers])
+
+
 def contact_validity(run, peaks: np.ndarray, peak_times: np.ndarray) -> dict:
     """Per finger: the largest out-of-plane shares of contact normal and sweep,
     the fold force and whether its largest force (``peaks``, N, at
@@ -133,14 +138,13 @@ def belt_contacts(run) -> dict:
 
 
 def validity_problems(validity: dict) -> list[str]:
-    """A run's reasons to distrust its model, in words (empty: none)."""
+    """A run's reasons to distrust its model, in words (empty: none). A finger
+    past its fold force is a jam (design/solve/grasp/simulation.py's
+    :func:`jam`), named there."""
     out = []
     if not validity["planar_model_valid"]:
         out.append(f"contact normals reach {validity['normal_out_of_plane_max']:.2f} out of the "
                    f"fingers' planes (planar model limit {PLANAR_LIMIT})")
-    out += [f"finger {b['finger']} pressed {b['force_N']:.1f} N, past its fold force "
-            f"{b['fold_force_N']:.1f} N, at {b['time_s']:.3f} s"
-            for b in validity["forces_beyond_fold"]]
     out += [f"finger {b['finger']} passed {1e3 * b['depth_m']:.1f} mm through the belt at "
             f"{b['time_s']:.3f} s" for b in validity["fingers_through_conveyor"]]
     held = validity.get("held_at_start", [])

@@ -13,7 +13,8 @@ Jacobian is exact). Constraints:
   N = 0, touch-down gap = 0, stick→slip |F_c| = µN, slip→stick slip = 0);
 * the mode holds at every node: stick N ≥ 0 and |F_c| ≤ µN, slip N ≥ 0 and
   the slip keeps its sign, air gap ≥ 0 (complementarity by phases);
-* the bruise cap on every finger's force at every stage;
+* the bruise cap on every finger's force at every stage, and its fold force
+  (scaled with its stiffness): a finger past it jams the bird;
 * Σ T_j = the horizon, the start on the belt from the closed-form belt
   motion, the design rules, and the trust region around the current design.
 
@@ -35,6 +36,7 @@ import numpy as np
 from design.interrupt import checkpoint
 from design.interrupt import requested as interrupt_requested
 from design.physics.bird import BirdDynamics, Loads, belt_motion
+from design.solve.grasp.validity import fold_force
 from design.solve.optimize.finger_load import FingerLoad
 from design.solve.optimize.schedule import STAGES, Schedule
 from design.solve.optimize.variables import DesignSpace, parameters_of
@@ -176,7 +178,7 @@ class DesignNLP:
     def _runge_kutta(self, grid, values) -> dict:
         """The RK4 stages of every interval: (j, k) -> (the summed finger
         loads at each stage, the stage derivatives k_s, the finger forces in
-        stage then finger order). Built stage by stage across all intervals
+        stage then finger order, each with its finger's index). Built stage by stage across all intervals
         (stage s needs stage s-1 of its own interval only), so that each
         finger and contact mode is one batched call per stage
         (FingerLoad.batch) instead of a call per interval."""
@@ -225,7 +227,7 @@ class DesignNLP:
                     if contact is not None:
                         load, force = results[j, k, i]
                         total += load
-                        out[j, k][2].append(force)
+                        out[j, k][2].append((force, i))
                 out[j, k][0].append(total)
                 _, v_dot, _ = self._belt(times[j, k], values)
                 mode_f = self._mode_function(phase.mode, phase.sign)
@@ -333,9 +335,16 @@ class DesignNLP:
                     if phase.end == "touch-down":
                         constrain(end[1] - dyn.support(end[2])[1], 0.0, 0.0, "touch-down")
         constrain(ca.sum1(durations), sch.t_end - sch.t_start, sch.t_end - sch.t_start, "horizon")
-        self.force = ca.vertcat(*forces)
+        self.force = ca.vertcat(*[f for f, _ in forces])
         if forces:
             constrain(self.force, -np.inf, cap, "cap")
+            # no finger past its fold force (a jam, design/solve/grasp/validity.py):
+            # the fold force scales with the finger's stiffness
+            grasper = self.setup.grasper.fingers
+            fold = ca.vertcat(*[fold_force(grasper[i].finger) *
+                                values[f"groups.{grasper[i].group}.stiffness_scale"]
+                                for _, i in forces])
+            constrain(self.force - fold, -np.inf, 0.0, "fold force")
         for expr, tag in rule_constraints(values, self.setup, rules):
             constrain(expr, 0.0, np.inf, tag)
         x = ca.vertcat(*[ca.vec(v) for v in w])

@@ -45,7 +45,7 @@ import numpy as np
 
 from design.solve.grasp.integrate import IntegratorSettings
 from design.solve.grasp.simulation import GraspRun, simulate_grasp
-from design.solve.grasp.validity import validity_problems
+from design.solve.grasp.validity import finger_limits, validity_problems
 from design.solve.optimize.population import Population, PopulationNLP
 from design.solve.optimize.profile import CONSTRUCTION, OPTIMISER, SIMULATIONS, VIEWS, Profile
 from design.solve.optimize.schedule import schedule_of
@@ -141,9 +141,27 @@ class Scored:
     def run(self) -> GraspRun:
         return self.members[self.limiting].run
 
+    def excess(self, caps, tolerance: float = 0.0) -> float:
+        """How far (N) the worst finger of any bird presses over its limit: the
+        bird's cap (N) or the finger's fold force, whichever is lower, within
+        ``tolerance`` (relative); inf where a bird is held to the end of its
+        run or not carried on (a jam no force measures)."""
+        worst = -np.inf
+        for m, cap in zip(self.members, np.broadcast_to(np.asarray(caps, float),
+                                                        (len(self.members),))):
+            s = m.run.summary
+            if any(not reason.startswith("finger ") for reason in s["jam"]):
+                return np.inf
+            limits = finger_limits(m.run.setup, cap)
+            peaks = np.array([s["max_force_per_finger_N"][gf.name]
+                              for gf in m.run.setup.grasper.fingers])
+            worst = max(worst, float(np.max(peaks - limits * (1 + tolerance))))
+        return worst
+
     def within(self, caps, tolerance: float = 0.0) -> bool:
-        """Does every bird stay under its cap (N), within ``tolerance`` (relative)?"""
-        return bool(np.all(self.peaks <= np.asarray(caps) * (1 + tolerance)))
+        """Does every bird stay under its cap (N) and every finger under its
+        fold force, within ``tolerance`` (relative), with no bird jammed?"""
+        return self.excess(caps, tolerance) <= 0.0
 
 
 @dataclass
@@ -210,15 +228,15 @@ def score(population: Population, d: np.ndarray, settings: LoopSettings,
 
 
 def better(a: Scored, b: Scored, caps) -> bool:
-    """Is a better than b: feasible (every bird under its cap) beats
-    infeasible, then the longer hold; among infeasible designs the smaller
-    largest excess over a cap."""
+    """Is a better than b: feasible (every bird under its cap, every finger
+    under its fold force, no jam) beats infeasible, then the longer hold;
+    among infeasible designs the smaller largest excess over a limit."""
     fa, fb = a.within(caps), b.within(caps)
     if fa != fb:
         return fa
     if fa:
         return a.hold > b.hold + 1e-5
-    return np.max(a.peaks - caps) < np.max(b.peaks - caps) - 1e-3
+    return a.excess(caps) < b.excess(caps) - 1e-3
 
 
 def population_of(space: DesignSpace | Population) -> Population:
@@ -471,10 +489,12 @@ def verify(space: DesignSpace | Population, d: np.ndarray, settings: LoopSetting
 
 
 def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
-    """The verification table's numbers and pass/fail."""
+    """The verification table's numbers and pass/fail: the hold reproduced,
+    the peak under the cap, and no jam (design/solve/grasp/simulation.py)."""
     hold_error = abs(verified.hold - nlp_hold) / max(nlp_hold, 1e-12)
-    passed = hold_error <= HOLD_TOLERANCE and verified.peak <= cap * (1 + CAP_TOLERANCE)
     s = verified.run.summary
+    passed = hold_error <= HOLD_TOLERANCE and verified.peak <= cap * (1 + CAP_TOLERANCE) \
+        and not s["jammed"]
     return {"hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
             "max_finger_force_N": verified.peak,
             "max_finger_force_finger": s["max_finger_force_finger"],
@@ -483,7 +503,7 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
             "hold_time_relative_difference": hold_error,
             "hold_tolerance": HOLD_TOLERANCE, "cap_tolerance": CAP_TOLERANCE,
             "model_warnings": validity_problems(s["validity"]),
-            "passed": bool(passed)}
+            "jam": s["jam"], "passed": bool(passed)}
 
 
 def population_verdict(population: Population, claims: list, verified: Scored, caps) -> dict:
