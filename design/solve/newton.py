@@ -151,3 +151,45 @@ def compiled_jacobian(residual: ca.Function, name: str) -> ca.Function:
     q = ca.SX.sym("q", residual.size1_in(1))
     r = residual(z, q)
     return compiled([ca.Function(name, [z, q], [ca.jacobian(r, z), r])]).functions[0]
+
+
+class Chord:
+    """Newton's method with the Jacobian of a nearby solution (the chord
+    method), for the many short continuation steps of a simulation: each
+    iteration is one residual evaluation (compiled where a compiler is,
+    design/solve/compiled.py) and one product with the inverse Jacobian
+    kept from that solution, instead of a Jacobian and its factorisation.
+    It converges linearly, fast while the Jacobian has changed little; the
+    caller falls back to Newton where it does not converge within the
+    iterations allowed. The root it converges to satisfies the same
+    tolerance as Newton's."""
+
+    def __init__(self, residual: ca.Function):
+        from design.solve.buffers import Buffered
+        from design.solve.compiled import compiled
+        self._residual = Buffered(compiled([residual]).functions[0])
+        z = ca.SX.sym("z", residual.size1_in(0))
+        q = ca.SX.sym("q", residual.size1_in(1))
+        self._jacobian = Buffered(ca.Function(f"{residual.name()}_dense_jz", [z, q],
+                                              [ca.densify(ca.jacobian(residual(z, q), z))]))
+
+    def inverse(self, z: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+        """∂R/∂z inverted at (z, q); None where it is singular."""
+        try:
+            return np.linalg.inv(self._jacobian(z, q)[0])
+        except np.linalg.LinAlgError:
+            return None
+
+    def solve(self, z0: np.ndarray, q: np.ndarray, inverse: np.ndarray, tolerance: float,
+              max_iter: int) -> np.ndarray | None:
+        """The root from z0 with max |R| ≤ ``tolerance``, or None."""
+        z = np.array(z0, float)
+        for _ in range(max_iter + 1):
+            r = self._residual(z, q)[0].ravel()
+            size = np.max(np.abs(r))
+            if size <= tolerance:
+                return z
+            if not np.isfinite(size):
+                return None
+            z -= inverse @ r
+        return None

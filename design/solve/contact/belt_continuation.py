@@ -37,6 +37,7 @@ import numpy as np
 
 from design.solve.buffers import Buffered
 from design.solve.contact.robust import BASE_REACHED, MAX_STEP_ITERATIONS
+from design.solve.contact.spatial import CHORD_ITERATIONS
 
 #: a contact event is located to within this penetration (m) ...
 EVENT_DEPTH = 1e-8
@@ -92,6 +93,9 @@ class Belted:
     held: float = 1.0
     #: planar: the side the bird bends the finger to (+1: towards +y)
     side: int = 0
+    #: the mode's residual Jacobian inverted at z (for the chord method; None:
+    #: not computed)
+    inverse: np.ndarray | None = None
 
 
 class BeltedContact:
@@ -190,6 +194,14 @@ class BeltedContact:
                 continue
             if new == "base":
                 return None, BASE_REACHED
+            if isinstance(new, tuple):
+                # a contact starts inside the step, ``depth`` deep at its end: aim
+                # just past the crossing, where the depth, near linear in the
+                # step, passes EVENT_DEPTH / 2 (a secant from the clearance now)
+                _, kind, depth = new
+                before = self.depth(state, kind)
+                h *= (-before + EVENT_DEPTH / 2) / (depth - before) if before < 0.0 else 0.5
+                continue
             h /= 2
             if h < 1e-7:
                 if exact:
@@ -199,8 +211,9 @@ class BeltedContact:
 
     def _step(self, state: Belted, at: Belted, h: float):
         """Solve at the parameters of ``at`` from ``state`` (a step of relative
-        size h): the new state; None (shorten the step: Newton failed, or a
-        contact starts inside it, to be located); ``base``."""
+        size h): the new state; None (shorten the step: Newton failed);
+        ("locate", kind, depth) (a contact starts inside it, ``depth`` m deep
+        at its end: shorten it to where it starts); ``base``."""
         mode, z = state.mode, state.z
         for _ in range(4):
             new = self._newton(replace(at, mode=mode, z=z))
@@ -213,12 +226,12 @@ class BeltedContact:
             if kind == "base":
                 return "base"
             if depth > EVENT_DEPTH and h > EVENT_STEP and kind in ("bird", "belt"):
-                return None
+                return "locate", kind, depth
             switched = self.switch(new, kind)
             if switched is None:
                 return None
             mode, z = switched.mode, switched.z
-            at = replace(at, side=switched.side)
+            at = replace(at, side=switched.side, inverse=None)
         return None
 
     def _newton(self, state: Belted) -> Belted | None:
@@ -228,12 +241,22 @@ class BeltedContact:
             return state
         newton, post = self.calls(state.mode)[:2]
         q = self.q(state)
-        z = newton(state.z, q)[0].ravel()
+        z = None if state.inverse is None else self.transcription(state.mode).chord.solve(
+            state.z, q, state.inverse, self.tolerance, CHORD_ITERATIONS)
+        if z is None:
+            z = newton(state.z, q)[0].ravel()
         self.newton_iterations += 1
         post, resid = (v.ravel() for v in post(z, q))
         if not (np.isfinite(resid[0]) and resid[0] < 1e-8):
             return None
-        return self.solved(replace(state, z=z), post)
+        return self.solved(replace(state, z=z, inverse=None), post)
+
+    def with_inverse(self, state: Belted) -> Belted:
+        """The state with its Jacobian inverse, for continuing by the chord method."""
+        if state.mode == "free":
+            return state
+        return replace(state, inverse=self.transcription(state.mode).chord.inverse(
+            state.z, self.q(state)))
 
     def calls(self, mode: str) -> tuple[Buffered, Buffered, Buffered]:
         """A mode's Newton solve (z0, q) -> z (at most MAX_STEP_ITERATIONS
@@ -266,6 +289,11 @@ class BeltedContact:
 
     def tip(self, state: Belted) -> np.ndarray:
         """The finger's tip in its frame (m)."""
+        raise NotImplementedError
+
+    def depth(self, state: Belted, kind: str) -> float:
+        """How far (m) the finger is into the belt (``kind`` belt: its tip) or
+        the bird (``bird``; the bird out of reach: -inf), < 0 clear of it."""
         raise NotImplementedError
 
     def event(self, state: Belted) -> tuple[str, float] | None:

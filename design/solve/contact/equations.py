@@ -29,6 +29,8 @@ circle and its axes are undefined (the optimiser's choice).
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import casadi as ca
 import numpy as np
 
@@ -37,7 +39,7 @@ from design.physics.ellipse import (Ellipse, gradient_casadi, gradient_conic, le
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import transcription
 from design.solve.compiled import compiled
-from design.solve.newton import NewtonCache, compiled_jacobian
+from design.solve.newton import Chord, NewtonCache, compiled_jacobian
 
 MODES = ("interior", "tip")
 #: ellipse parameterisations: (level, gradient) functions of (x, y, q[ELLIPSE])
@@ -119,6 +121,11 @@ class ContactTranscription:
             f"contact_{self.mode}_newton", self.residual, "qr",
             lambda: compiled_jacobian(self.residual,
                                       f"{self.residual.name()}_{self.ellipse}_jac_z"))
+
+    @cached_property
+    def chord(self) -> Chord:
+        """The chord method on this mode's residual (design.solve.newton.Chord)."""
+        return Chord(self.residual)
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 40,
                    error_on_fail: bool = False, compiled_jacobian: bool = True

@@ -77,7 +77,7 @@ class PlanarBeltContact(BeltedContact):
         state, msg = self.continued(target, previous)
         if state is None:
             return self._failed(msg), None
-        return self._solution(state, msg, detail), state
+        return self._solution(state, msg, detail), self.with_inverse(state) if detail else state
 
     def adopt(self, state, line: Plane, belt: np.ndarray) -> Belted:
         """A bird-only state of :class:`RobustContact` to continue here, with
@@ -154,15 +154,16 @@ class PlanarBeltContact(BeltedContact):
         if mode in BELT_MODES:
             if post[POST_BELT_FORCE] < 0:
                 return "release-belt", 0.0
-        else:
-            depth = -float(state.plane.level(self.tip(state)[:, None])[0])
-            if depth > 0.0:
-                return "belt", depth
-        if mode not in BIRD_MODES and state.bird is not None:
-            depth = self._bird_depth(state)
-            if depth > 0.0:
-                return "bird", depth
+        elif self.depth(state, "belt") > 0.0:
+            return "belt", self.depth(state, "belt")
+        if mode not in BIRD_MODES and self.depth(state, "bird") > 0.0:
+            return "bird", self.depth(state, "bird")
         return None
+
+    def depth(self, state: Belted, kind: str) -> float:
+        if kind == "belt":
+            return -float(state.plane.level(self.tip(state)[:, None])[0])
+        return -np.inf if state.bird is None else self._bird_depth(state)
 
     def switch(self, state: Belted, kind: str) -> Belted | None:
         mode, z, n1, n2 = state.mode, state.z, self.n_beam, self.n_over

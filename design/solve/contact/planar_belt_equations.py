@@ -36,6 +36,8 @@ and the belt's force on the finger (2).
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import casadi as ca
 import numpy as np
 
@@ -43,7 +45,7 @@ from design.physics.ellipse import gradient_conic, level_conic
 from design.physics.stiffness import Stiffness
 from design.solve.beam.collocation import transcription
 from design.solve.contact.spatial_belt_equations import OVERHANG_INTERVALS
-from design.solve.newton import NewtonCache, compiled_jacobian
+from design.solve.newton import Chord, NewtonCache, compiled_jacobian
 
 #: index of the conic, the bird's signed friction, the belt's line and its law in q
 CONIC = slice(2, 7)
@@ -176,6 +178,11 @@ class PlanarBeltTranscription:
         self._newton = NewtonCache(
             f"{name}_newton", self.residual, "qr",
             lambda: compiled_jacobian(self.residual, f"{self.residual.name()}_jac_z"))
+
+    @cached_property
+    def chord(self) -> Chord:
+        """The chord method on this mode's residual (design.solve.newton.Chord)."""
+        return Chord(self.residual)
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 30,
                    error_on_fail: bool = False, compiled_jacobian: bool = False

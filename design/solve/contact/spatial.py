@@ -44,6 +44,9 @@ from design.solve.newton import implicit_rate
 GRAZES = "the straight finger only grazes the object"
 #: residual (dimensionless) below which a Newton solve counts as converged
 RESIDUAL_TOL = 1e-8
+#: chord iterations a continued solve may take before Newton takes over (a
+#: simulation's step converges in 3-10; more means the Jacobian has changed)
+CHORD_ITERATIONS = 12
 
 
 @dataclass(frozen=True)
@@ -119,6 +122,9 @@ class SpatialState:
     quadric: Quadric
     friction: np.ndarray
     post: np.ndarray
+    #: the residual's Jacobian inverted at z (for the chord method; None: not
+    #: computed, as for a trial evaluation's state)
+    inverse: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -245,6 +251,8 @@ class SpatialContact:
         self.ei_ref = finger.stiffness.compliance_equivalent(finger.length)
         straight = straight_solution(PointLoad(0.0, 0.0, finger.length), "", 3)
         self.widths = adapted_widths(intervals, finger.stiffness, [straight])
+        #: the parameters that follow the quadric and friction law (mesh, stiffness)
+        self.tail = np.concatenate([self.widths, self.stiffness.params])
         self.tr = {m: spatial_transcription(self.stiffness, intervals, degree, m) for m in MODES}
         self.newton_iterations = 0
         self._last_iterations = 0
@@ -264,8 +272,12 @@ class SpatialContact:
                                               "pose", converged=False), None
         if segment_level(quadric, length) >= 0.0:
             return no_spatial_contact(length, "the straight finger misses the object"), None
-        # the usual case, a short step: geometry and friction in one Newton
-        state = self._step(previous, quadric, friction) if previous is not None else None
+        # the usual case, a short step: geometry and friction in one solve, by
+        # the chord method from the continued solution's Jacobian, else Newton
+        state = None
+        if previous is not None:
+            state = self._chord(previous, quadric, friction) or \
+                self._step(previous, quadric, friction)
         held, msg = 1.0, ""
         if not isinstance(state, SpatialState):
             state, held, msg = self._settle(quadric, friction, previous)
@@ -273,7 +285,27 @@ class SpatialContact:
                 return no_spatial_contact(length, msg, converged=msg == GRAZES), None
         sol = self._solution(state, msg, detail)
         sol.extras["friction_held"] = held
+        if detail:
+            state.inverse = self.tr[state.mode].chord.inverse(
+                state.z, self._params(state.quadric, state.friction))
         return sol, state
+
+    def _chord(self, previous: SpatialState, quadric: Quadric, friction: np.ndarray
+               ) -> SpatialState | None:
+        """The contact at the new parameters by the chord method from
+        ``previous`` (its mode kept), if it has its Jacobian and converges
+        within CHORD_ITERATIONS with the mode still right; else None."""
+        if previous.inverse is None:
+            return None
+        tr = self.tr[previous.mode]
+        q = self._params(quadric, friction)
+        z = tr.chord.solve(previous.z, q, previous.inverse, self.tolerance, CHORD_ITERATIONS)
+        if z is None:
+            return None
+        post = np.asarray(tr.post(z, q)[0]).ravel()
+        if self._check(previous.mode, post) != "ok":
+            return None
+        return SpatialState(previous.mode, z, quadric, friction, post)
 
     def _settle(self, quadric: Quadric, friction: np.ndarray, previous: SpatialState | None):
         """The geometry first, continued from ``previous`` under the friction
@@ -318,7 +350,7 @@ class SpatialContact:
     # ------------------------------------------------------- continuation
     def _params(self, quadric: Quadric, friction: np.ndarray) -> np.ndarray:
         return np.concatenate([[self.finger.length, self.ei_ref], quadric.params, friction,
-                               self.widths, self.stiffness.params])
+                               self.tail])
 
     def _apply_friction(self, state: SpatialState, friction: np.ndarray
                         ) -> tuple[SpatialState, float]:

@@ -47,6 +47,7 @@ class SpatialBeltContact(BeltedContact):
         self.length = contact.finger.length
         self.tolerance, self.max_steps = contact.tolerance, contact.max_steps
         self.widths2 = overhang_widths()
+        self.belt_tail = np.concatenate([contact.widths, self.widths2, contact.stiffness.params])
         rod = contact.tr["interior"].rod
         self.n_rod = rod.n_w
         self.tr = {m: belt_transcription(contact.stiffness, rod.K, rod.d, m) for m in BELT_MODES}
@@ -68,7 +69,7 @@ class SpatialBeltContact(BeltedContact):
         state, msg = self.continued(target, previous)
         if state is None:
             return self._failed(msg), None
-        return self._solution(state, msg, detail), state
+        return self._solution(state, msg, detail), self.with_inverse(state) if detail else state
 
     def adopt(self, state: SpatialState, plane: Plane, belt) -> Belted:
         """A bird-only state of :class:`SpatialContact` to continue here, with
@@ -103,10 +104,8 @@ class SpatialBeltContact(BeltedContact):
         bird = _NO_BIRD.params if state.bird is None else state.bird
         if state.mode in BELT_MODES:
             return np.concatenate([[self.length, c.ei_ref], bird, state.friction,
-                                   state.plane.params, state.belt, c.widths, self.widths2,
-                                   c.stiffness.params])
-        return np.concatenate([[self.length, c.ei_ref], bird, state.friction, c.widths,
-                               c.stiffness.params])
+                                   state.plane.params, state.belt, self.belt_tail])
+        return np.concatenate([[self.length, c.ei_ref], bird, state.friction, c.tail])
 
     def solved(self, state: Belted, post: np.ndarray) -> Belted:
         if state.mode in BELT_MODES:
@@ -133,15 +132,16 @@ class SpatialBeltContact(BeltedContact):
         if mode in BELT_MODES:
             if post[POST_BELT_FORCE] < 0:
                 return "release-belt", 0.0
-        else:
-            depth = -float(state.plane.level(self.tip(state)[:, None])[0])
-            if depth > 0.0:
-                return "belt", depth
-        if mode not in BIRD_MODES and state.bird is not None:
-            depth = self._bird_depth(state)
-            if depth > 0.0:
-                return "bird", depth
+        elif self.depth(state, "belt") > 0.0:
+            return "belt", self.depth(state, "belt")
+        if mode not in BIRD_MODES and self.depth(state, "bird") > 0.0:
+            return "bird", self.depth(state, "bird")
         return None
+
+    def depth(self, state: Belted, kind: str) -> float:
+        if kind == "belt":
+            return -float(state.plane.level(self.tip(state)[:, None])[0])
+        return -np.inf if state.bird is None else self._bird_depth(state)
 
     def switch(self, state: Belted, kind: str) -> Belted | None:
         mode, z, n1, n2 = state.mode, state.z, self.n_rod, self.n_over

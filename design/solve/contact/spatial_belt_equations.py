@@ -41,13 +41,15 @@ normal force (3).
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import casadi as ca
 import numpy as np
 
 from design.solve.beam.rod import RodStiffness, rod_transcription
 from design.solve.contact.spatial_equations import FRICTION, QUADRIC, friction_vector, \
     quadric_matrix
-from design.solve.newton import NewtonCache, compiled_jacobian
+from design.solve.newton import Chord, NewtonCache, compiled_jacobian
 
 #: index of the belt plane (n, e) and of its friction law in q
 PLANE = slice(FRICTION.stop, FRICTION.stop + 4)
@@ -172,6 +174,11 @@ class BeltTranscription:
         self._newton = NewtonCache(
             f"{name}_newton", self.residual, "lapacklu",
             lambda: compiled_jacobian(self.residual, f"{self.residual.name()}_jac_z"))
+
+    @cached_property
+    def chord(self) -> Chord:
+        """The chord method on this mode's residual (design.solve.newton.Chord)."""
+        return Chord(self.residual)
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 30,
                    error_on_fail: bool = False, compiled_jacobian: bool = False

@@ -32,11 +32,13 @@ Parameters q = [l, EI_r, c (3), Q00, Q01, Q02, Q11, Q12, Q22, friction law
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import casadi as ca
 import numpy as np
 
 from design.solve.beam.rod import RodStiffness, rod_transcription
-from design.solve.newton import NewtonCache, compiled_jacobian
+from design.solve.newton import Chord, NewtonCache, compiled_jacobian
 
 MODES = ("interior", "tip")
 #: index of the quadric (c, Q) in q
@@ -127,6 +129,11 @@ class SpatialContactTranscription:
         self._newton = NewtonCache(
             f"spatial_{mode}_newton", self.residual, "lapacklu",
             lambda: compiled_jacobian(self.residual, f"{self.residual.name()}_jac_z"))
+
+    @cached_property
+    def chord(self) -> Chord:
+        """The chord method on this mode's residual (design.solve.newton.Chord)."""
+        return Chord(self.residual)
 
     def rootfinder(self, tolerance: float = 1e-12, max_iter: int = 30,
                    error_on_fail: bool = False, compiled_jacobian: bool = False
