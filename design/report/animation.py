@@ -1,0 +1,160 @@
+"""The frames of a grasp run's animation, and what is drawn in them.
+
+A run's result keeps the bird's state at evenly spaced frame times
+(design/run/animation.py). At each frame every finger's contact is solved
+at that state (:class:`~design.solve.grasp.fingers.FingerForces`, committed
+frame by frame in time order, each continued from the frame before), which
+gives its deflected shape, its force on the bird and the contact point.
+
+Conventions: world frame of docs/MODEL.md ("Frames"), SI units; the left
+drum mirrors the right one (Y → -Y).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from design.physics.kinematics import Ellipsoid, rot_y
+from design.report.grasp_figures import finger_curves
+from design.run.animation import STATE
+from design.solve.grasp.fingers import FingerForces
+from design.solve.grasp.simulation import GraspSetup
+
+#: points kept of a deflected finger's shape (base and tip among them)
+FINGER_POINTS = 12
+MIRROR = np.array([1.0, -1.0, 1.0])
+
+
+@dataclass
+class Frame:
+    """One instant of a run, right drum (SI, world frame): the bird's state
+    (6,), N (N), the belt's travel (m), every finger's shape (3, n), force
+    on the bird (3,) and contact point (3,) or None."""
+
+    t: float
+    y: np.ndarray
+    normal: float
+    belt_travel: float
+    curves: list[np.ndarray]
+    forces: np.ndarray
+    points: list[np.ndarray | None]
+
+    def touching(self, names: list[str]) -> list[str]:
+        """The fingers pressing on the bird (right drum; the left mirrors them)."""
+        return [n for n, f in zip(names, self.forces) if np.linalg.norm(f) > 0]
+
+
+@dataclass
+class RunFrames:
+    """A run's frames with its setup; ``recorded`` the run's own recorded
+    instants the frames were interpolated from."""
+
+    label: str
+    setup: GraspSetup
+    frames: list[Frame]
+    recorded: int
+
+    @property
+    def names(self) -> list[str]:
+        return [gf.name for gf in self.setup.grasper.fingers]
+
+
+def animated_runs(record: dict) -> list[RunFrames]:
+    """The runs of a result's ``animation`` (design/run/animation.py), each
+    set up from its scene and its fingers solved at every frame
+    (:func:`solve_frames`). Raises
+    :class:`~design.errors.ProblemFileError` for a scene that does not read,
+    :class:`~design.solve.grasp.fingers.ContactFailed` for a contact that
+    cannot be solved."""
+    from design.io.scene import load_scene
+    from design.run.grasp import setup_of
+
+    runs = []
+    for label, run in record["runs"].items():
+        scene = load_scene(run["scene"])
+        runs.append(solve_frames(label, setup_of(scene), scene.settings.contact_nodes,
+                                 run["states"], run["recorded_instants"]))
+    return runs
+
+
+def solve_frames(label: str, setup: GraspSetup, contact_nodes: int, states: dict,
+                 recorded: int) -> RunFrames:
+    """Every finger's contact solved at each frame's state (``states``: a
+    :func:`~design.run.animation.frame_states` dict), in time order, each
+    continued from the frame before. Raises
+    :class:`~design.solve.grasp.fingers.ContactFailed` where a contact
+    cannot be solved."""
+    forces = FingerForces(setup.grasper, setup.bird, setup.drum_speed, setup.finger_friction,
+                          intervals=contact_nodes, model=setup.finger_model)
+    y = np.column_stack([states[k] for k in STATE])
+    frames = []
+    for k, t in enumerate(states["t_s"]):
+        _, fingers = forces.evaluate(t, y[k], commit=True)
+        frames.append(Frame(t, y[k], states["N_N"][k], states["belt_travel_m"][k],
+                            [_thinned(c) for c in finger_curves(setup, t, fingers)],
+                            np.array([f.force for f in fingers]),
+                            [f.point for f in fingers]))
+    return RunFrames(label, setup, frames, recorded)
+
+
+def _thinned(curve: np.ndarray) -> np.ndarray:
+    """At most FINGER_POINTS of a finger's points, its ends kept."""
+    n = curve.shape[1]
+    return curve if n <= FINGER_POINTS else curve[:, np.linspace(0, n - 1, FINGER_POINTS).round()
+                                                  .astype(int)]
+
+
+def both_drums(curves: list[np.ndarray]) -> list[np.ndarray]:
+    """The right drum's finger curves followed by their left mirror images."""
+    return list(curves) + [c * MIRROR[:, None] for c in curves]
+
+
+def bird_surface(setup: GraspSetup, y: np.ndarray, n: int = 11) -> np.ndarray:
+    """The bird's ellipsoid at state y as a grid of world points (3, n, 2n)."""
+    b = setup.bird
+    body = Ellipsoid(b.eta, b.lam, b.gamma, (y[0], 0.0, y[1]), y[2])
+    polar, around = np.meshgrid(np.linspace(0.0, np.pi, n), np.linspace(0.0, 2 * np.pi, 2 * n),
+                                indexing="ij")
+    local = np.stack([b.eta * np.sin(polar) * np.cos(around),
+                      b.lam * np.sin(polar) * np.sin(around), b.gamma * np.cos(polar)])
+    return np.einsum("ij,jkl->ikl", body.rotation, local) + \
+        np.asarray(body.center)[:, None, None]
+
+
+def drum_profile(setup: GraspSetup) -> list[tuple[float, float]]:
+    """The right drum's outline as (height m, radius m) pairs, bottom to top:
+    the radius at each height a finger is mounted (the largest where
+    several are); one height gives a disc 10 mm thick."""
+    rings: dict[float, float] = {}
+    for gf in setup.grasper.fingers:
+        h = gf.mount.height
+        rings[h] = max(rings.get(h, 0.0), gf.mount.radius)
+    profile = sorted(rings.items())
+    if len(profile) == 1:
+        (h, r), = profile
+        profile = [(h - 0.005, r), (h + 0.005, r)]
+    return profile
+
+
+def drum_surface(setup: GraspSetup, side: int, n: int = 36) -> np.ndarray:
+    """The right (side = 1) or left (side = -1) drum's surface of revolution
+    through :func:`drum_profile`, closed at both ends: world points
+    (3, rings + 2, n)."""
+    g = setup.grasper
+    profile = drum_profile(setup)
+    heights = [profile[0][0]] + [h for h, _ in profile] + [profile[-1][0]]
+    radii = [0.0] + [r for _, r in profile] + [0.0]
+    a = np.linspace(0.0, 2 * np.pi, n)
+    local = np.stack([np.outer(radii, np.cos(a)), np.outer(radii, np.sin(a)),
+                      np.outer(heights, np.ones(n))])
+    origin = np.array([g.x, -g.spacing / 2, 0.0])
+    world = np.einsum("ij,jkl->ikl", rot_y(g.tilt), local) + origin[:, None, None]
+    return world if side == 1 else world * MIRROR[:, None, None]
+
+
+def belt_half_width(setup: GraspSetup) -> float:
+    """Half the belt's drawn width (m): the gap between the drums (the
+    scenes give no belt width)."""
+    return setup.grasper.spacing / 2 - max(r for _, r in drum_profile(setup))
