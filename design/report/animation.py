@@ -17,13 +17,20 @@ from dataclasses import dataclass
 import numpy as np
 
 from design.physics.kinematics import Ellipsoid, rot_y
-from design.report.grasp_figures import finger_curves
+from design.report.grasp_figures import drum_profile, finger_curves
 from design.run.animation import STATE
 from design.solve.grasp.fingers import FingerForces
 from design.solve.grasp.simulation import GraspSetup
 
 #: points kept of a deflected finger's shape (base and tip among them)
 FINGER_POINTS = 12
+#: arrow length per newton of a finger's force on the bird (mm/N)
+ARROW_MM_PER_N = 5.0
+#: the force colours, from no force (green) to the cap (red; above it too)
+FORCE_SCALE = [[0.0, "#1a9850"], [0.5, "#fee08b"], [1.0, "#d73027"]]
+BIRD_COLOUR = "#c8a064"
+#: spacing of the stripes drawn across the belt, which travel with it (m)
+STRIPE = 0.05
 MIRROR = np.array([1.0, -1.0, 1.0])
 
 
@@ -123,21 +130,6 @@ def bird_surface(setup: GraspSetup, y: np.ndarray, n: int = 11) -> np.ndarray:
         np.asarray(body.center)[:, None, None]
 
 
-def drum_profile(setup: GraspSetup) -> list[tuple[float, float]]:
-    """The right drum's outline as (height m, radius m) pairs, bottom to top:
-    the radius at each height a finger is mounted (the largest where
-    several are); one height gives a disc 10 mm thick."""
-    rings: dict[float, float] = {}
-    for gf in setup.grasper.fingers:
-        h = gf.mount.height
-        rings[h] = max(rings.get(h, 0.0), gf.mount.radius)
-    profile = sorted(rings.items())
-    if len(profile) == 1:
-        (h, r), = profile
-        profile = [(h - 0.005, r), (h + 0.005, r)]
-    return profile
-
-
 def drum_surface(setup: GraspSetup, side: int, n: int = 36) -> np.ndarray:
     """The right (side = 1) or left (side = -1) drum's surface of revolution
     through :func:`drum_profile`, closed at both ends: world points
@@ -158,3 +150,28 @@ def belt_half_width(setup: GraspSetup) -> float:
     """Half the belt's drawn width (m): the gap between the drums (the
     scenes give no belt width)."""
     return setup.grasper.spacing / 2 - max(r for _, r in drum_profile(setup))
+
+
+def stripes(run: RunFrames, travel: float, x_range: tuple[float, float]) -> list[np.ndarray]:
+    """Stripes across the belt every STRIPE, moved on by the belt's travel (m)."""
+    w = belt_half_width(run.setup)
+    first = np.ceil((x_range[0] - travel) / STRIPE) * STRIPE + travel
+    return [np.array([[x, x], [-w, w], [0.0005, 0.0005]])
+            for x in np.arange(first, x_range[1], STRIPE)]
+
+
+def extent(runs: list[RunFrames]) -> np.ndarray:
+    """The box drawn (3, 2), in m: the grasper's drums and fingers over the
+    runs, widened by the bird's largest semi-axis and up to the bird's
+    highest point; the bird is clipped where it is outside (upstream)."""
+    pts = []
+    for run in runs:
+        pts += [drum_surface(run.setup, 1).reshape(3, -1)]
+        pts += [np.hstack(both_drums(f.curves)) for f in run.frames]
+    allp = np.hstack(pts)
+    reach = max(max(r.setup.bird.eta, r.setup.bird.lam, r.setup.bird.gamma) for r in runs)
+    lo, hi = allp.min(axis=1) - reach, allp.max(axis=1) + reach
+    lo[2] = min(allp[2].min(), 0.0) - 0.01
+    top = max(f.y[1] + r.setup.bird.eta for r in runs for f in r.frames)
+    hi[2] = max(allp[2].max(), top) + 0.01
+    return np.column_stack([lo, hi])

@@ -6,7 +6,7 @@ import numpy as np
 
 from design.report import grasp_figures as gf
 from design.report.page import Page
-from design.report.viewer import ARROW_MM_PER_N
+from design.report.animation import ARROW_MM_PER_N
 from design.solve.grasp.simulation import GraspRun
 
 
@@ -34,19 +34,23 @@ def animation_section(page: Page, result: dict) -> None:
     the fingers solved again at every frame; where a contact cannot be
     solved, the reason instead."""
     from design.report.animation import animated_runs
-    from design.report.viewer import animation_html
     from design.solve.grasp.fingers import ContactFailed
 
-    record = result["animation"]
     page.section("Animation", "animation")
-    step = record["frame_step_s"]
     try:
-        runs = animated_runs(record)
+        runs = animated_runs(result["animation"])
     except ContactFailed as exc:
         page.text(f"No animation: {exc}.")
         return
+    animation_view(page, runs, result["animation"])
+
+
+def animation_view(page: Page, runs: list, record: dict) -> None:
+    """The interactive view of ``runs`` (RunFrames) and what it shows."""
+    from design.report.viewer import animation_html
+
+    step, cap = record["frame_step_s"], record["cap_N"]
     recorded = ", ".join(f"{r.label} {r.recorded}" for r in runs)
-    cap = record["cap_N"]
     page.text(f"Frames every {1e3 * step:g} ms ({len(runs[0].frames)} frames; the bird's state "
               f"interpolated linearly between the run's recorded instants: {recorded}); at "
               f"each frame every finger's contact is solved again at that state. Arrows: each "

@@ -17,20 +17,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from design.report.animation import (RunFrames, belt_half_width, bird_surface, both_drums,
-                                     drum_surface)
-from design.report.grasp_figures import COLOURS
+from design.report.animation import (ARROW_MM_PER_N, BIRD_COLOUR, FORCE_SCALE, RunFrames,
+                                     belt_half_width, bird_surface, both_drums, drum_surface,
+                                     extent, stripes)
+from design.report.grasp_figures import COLOURS, MM
 
-MM = 1e3
-#: arrow length per newton of force (mm/N)
-ARROW_MM_PER_N = 5.0
-#: the force colours: green at no force, red at the cap (and above)
-FORCE_SCALE = [[0.0, "#1a9850"], [0.5, "#fee08b"], [1.0, "#d73027"]]
-BIRD_COLOUR = "#c8a064"
 #: playback speeds offered, as fractions of real time
 SPEEDS = (0.1, 0.25, 1.0)
-#: spacing of the stripes drawn across the belt (m)
-STRIPE = 0.05
 #: how far the view is zoomed in on the box drawn (orthographic: the box's
 #: longest side spans ZOOM times the viewport's unit)
 ZOOM = 3.0
@@ -61,14 +54,6 @@ def _surface(points: np.ndarray, colour: str, scene: str, opacity: float = 1.0,
             "hoverinfo": "skip", "name": name}
 
 
-def _belt_stripes(run: RunFrames, travel: float, x_range: tuple[float, float]) -> list[np.ndarray]:
-    """Stripes across the belt every STRIPE, moved on by the belt's travel (m)."""
-    w = belt_half_width(run.setup)
-    first = np.ceil((x_range[0] - travel) / STRIPE) * STRIPE + travel
-    return [np.array([[x, x], [-w, w], [0.0005, 0.0005]])
-            for x in np.arange(first, x_range[1], STRIPE)]
-
-
 def _arrows(frame) -> tuple[list[np.ndarray], list[float], dict]:
     """Both drums' force arrows: shafts (3, 2) from the tail to the contact
     point, their magnitudes (N) and the cones at their heads."""
@@ -97,7 +82,7 @@ def _dynamic(run: RunFrames, k: int, scene: str, cmax: float,
     heads."""
     frame = run.frames[k]
     traces = []
-    sx, sy, sz = _polylines(_belt_stripes(run, frame.belt_travel, x_range))
+    sx, sy, sz = _polylines(stripes(run, frame.belt_travel, x_range))
     traces.append({"type": "scatter3d", "scene": scene, "mode": "lines", "x": sx, "y": sy,
                    "z": sz, "line": {"color": "#9a9a9a", "width": 3}, "hoverinfo": "skip",
                    "showlegend": False})
@@ -141,23 +126,6 @@ def _static(run: RunFrames, scene: str, x_range: tuple[float, float], cmax: floa
     return traces
 
 
-def _extent(runs: list[RunFrames]) -> np.ndarray:
-    """The box drawn (3, 2), in m: the grasper's drums and fingers over the
-    runs, widened by the bird's largest semi-axis and up to the bird's
-    highest point; the bird is clipped where it is outside (upstream)."""
-    pts = []
-    for run in runs:
-        pts += [drum_surface(run.setup, 1).reshape(3, -1)]
-        pts += [np.hstack(both_drums(f.curves)) for f in run.frames]
-    allp = np.hstack(pts)
-    reach = max(max(r.setup.bird.eta, r.setup.bird.lam, r.setup.bird.gamma) for r in runs)
-    lo, hi = allp.min(axis=1) - reach, allp.max(axis=1) + reach
-    lo[2] = min(allp[2].min(), 0.0) - 0.01
-    top = max(f.y[1] + r.setup.bird.eta for r in runs for f in r.frames)
-    hi[2] = max(allp[2].max(), top) + 0.01
-    return np.column_stack([lo, hi])
-
-
 def _caption(run: RunFrames, k: int) -> str:
     frame = run.frames[k]
     touching = ", ".join(frame.touching(run.names)) or "none"
@@ -172,7 +140,7 @@ def animation_figure(runs: list[RunFrames], step: float, cap: float | None) -> d
     peak = max((np.linalg.norm(f.forces, axis=1).max() for r in runs for f in r.frames),
                default=0.0)
     cmax = cap if cap is not None else max(peak, 1.0)
-    box = _extent(runs)
+    box = extent(runs)
     x_range = (box[0, 0], box[0, 1])
     scenes = [f"scene{i + 1}" if i else "scene" for i in range(len(runs))]
     data, dynamic = [], []
