@@ -33,13 +33,14 @@ def animation_section(page: Page, result: dict) -> None:
     """The 3-D animation of the result's runs (its ``animation`` entry),
     the fingers solved again at every frame; where a contact cannot be
     solved, the reason instead."""
+    from design.errors import ProblemFileError
     from design.report.animation import animated_runs
     from design.solve.grasp.fingers import ContactFailed
 
     page.section("Animation", "animation")
     try:
         runs = animated_runs(result["animation"])
-    except ContactFailed as exc:
+    except (ContactFailed, ProblemFileError) as exc:
         page.text(f"No animation: {exc}.")
         return
     animation_view(page, runs, result["animation"])

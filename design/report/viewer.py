@@ -219,7 +219,7 @@ def _slider(run: RunFrames, count: int) -> dict:
 
 
 def animation_html(runs: list[RunFrames], step: float, cap: float | None,
-                   div_id: str = "animation") -> str:
+                   div_id: str = "animation-view") -> str:
     """The figure as an HTML fragment with plotly.js inlined (no network)."""
     import plotly.io as pio
 
