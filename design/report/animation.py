@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from design.physics.kinematics import Ellipsoid, rot_y
-from design.report.grasp_figures import drum_profile, finger_curves
+from design.physics.kinematics import MIRROR, Ellipsoid, rot_y
+from design.report.grasp_figures import MM, drum_profile, finger_curves
 from design.run.animation import STATE
 from design.solve.grasp.fingers import FingerForces
 from design.solve.grasp.simulation import GraspSetup
@@ -31,7 +31,6 @@ FORCE_SCALE = [[0.0, "#1a9850"], [0.5, "#fee08b"], [1.0, "#d73027"]]
 BIRD_COLOUR = "#c8a064"
 #: spacing of the stripes drawn across the belt, which travel with it (m)
 STRIPE = 0.05
-MIRROR = np.array([1.0, -1.0, 1.0])
 
 
 @dataclass
@@ -115,7 +114,22 @@ def _thinned(curve: np.ndarray) -> np.ndarray:
 
 def both_drums(curves: list[np.ndarray]) -> list[np.ndarray]:
     """The right drum's finger curves followed by their left mirror images."""
-    return list(curves) + [c * MIRROR[:, None] for c in curves]
+    return list(curves) + [MIRROR @ c for c in curves]
+
+
+def arrows(frame: Frame) -> list[tuple[np.ndarray, np.ndarray, np.ndarray, float]]:
+    """Both drums' force arrows: (tail, tip, force, magnitude) for every
+    finger touching the bird and its mirror image; the tip at the contact
+    point (m), the tail ARROW_MM_PER_N mm per N back along the force (N)."""
+    out = []
+    for f, p in zip(frame.forces, frame.points):
+        magnitude = float(np.linalg.norm(f))
+        if p is None or magnitude == 0.0:
+            continue
+        for m in (np.eye(3), MIRROR):
+            tip, force = m @ p, m @ f
+            out.append((tip - force * ARROW_MM_PER_N / MM, tip, force, magnitude))
+    return out
 
 
 def bird_surface(setup: GraspSetup, y: np.ndarray, n: int = 11) -> np.ndarray:
@@ -143,7 +157,7 @@ def drum_surface(setup: GraspSetup, side: int, n: int = 36) -> np.ndarray:
                       np.outer(heights, np.ones(n))])
     origin = np.array([g.x, -g.spacing / 2, 0.0])
     world = np.einsum("ij,jkl->ikl", rot_y(g.tilt), local) + origin[:, None, None]
-    return world if side == 1 else world * MIRROR[:, None, None]
+    return world if side == 1 else np.einsum("ij,jkl->ikl", MIRROR, world)
 
 
 def belt_half_width(setup: GraspSetup) -> float:

@@ -16,7 +16,7 @@ from matplotlib.cm import ScalarMappable
 from matplotlib.colors import LinearSegmentedColormap, Normalize
 from matplotlib.figure import Figure
 
-from design.report.animation import (ARROW_MM_PER_N, BIRD_COLOUR, FORCE_SCALE, RunFrames,
+from design.report.animation import (BIRD_COLOUR, FORCE_SCALE, RunFrames, arrows,
                                      belt_half_width, bird_surface, both_drums, drum_surface,
                                      extent, stripes)
 from design.report.grasp_figures import COLOURS, MM
@@ -77,14 +77,9 @@ def _draw(ax, run: RunFrames, k: int, box: np.ndarray, norm: Normalize) -> None:
     for j, curve in enumerate(frame.curves):
         for c in both_drums([curve]):
             ax.plot(*c * MM, color=COLOURS[j % len(COLOURS)], lw=2)
-    for f, p in zip(frame.forces, frame.points):
-        magnitude = float(np.linalg.norm(f))
-        if p is None or magnitude == 0.0:
-            continue
-        for m in (np.array([1.0, 1.0, 1.0]), np.array([1.0, -1.0, 1.0])):
-            tail = (p * m) * MM - f * m * ARROW_MM_PER_N
-            ax.quiver(*tail, *(f * m * ARROW_MM_PER_N), color=FORCE_COLOURS(norm(magnitude)),
-                      linewidth=2.5, arrow_length_ratio=0.25)
+    for tail, tip, _, magnitude in arrows(frame):
+        ax.quiver(*tail * MM, *(tip - tail) * MM, color=FORCE_COLOURS(norm(magnitude)),
+                  linewidth=2.5, arrow_length_ratio=0.25)
     ax.set_xlim(*box[0])
     ax.set_ylim(*box[1])
     ax.set_zlim(*box[2])

@@ -18,14 +18,14 @@ from __future__ import annotations
 import numpy as np
 
 from design.report.animation import (ARROW_MM_PER_N, BIRD_COLOUR, FORCE_SCALE, RunFrames,
-                                     belt_half_width, bird_surface, both_drums, drum_surface,
-                                     extent, stripes)
+                                     arrows, belt_half_width, bird_surface, both_drums,
+                                     drum_surface, extent, stripes)
 from design.report.grasp_figures import COLOURS, MM
 
 #: playback speeds offered, as fractions of real time
 SPEEDS = (0.1, 0.25, 1.0)
-#: how far the view is zoomed in on the box drawn (orthographic: the box's
-#: longest side spans ZOOM times the viewport's unit)
+#: the box's longest side in plotly's aspect ratio units: the zoom of its
+#: orthographic view, which scales with the aspect ratio
 ZOOM = 3.0
 #: height of a scene (px)
 HEIGHT = 720
@@ -54,33 +54,13 @@ def _surface(points: np.ndarray, colour: str, scene: str, opacity: float = 1.0,
             "hoverinfo": "skip", "name": name}
 
 
-def _arrows(frame) -> tuple[list[np.ndarray], list[float], dict]:
-    """Both drums' force arrows: shafts (3, 2) from the tail to the contact
-    point, their magnitudes (N) and the cones at their heads."""
-    shafts, size, heads = [], [], {k: [] for k in "xyzuvw"}
-    for f, p in zip(frame.forces, frame.points):
-        magnitude = float(np.linalg.norm(f))
-        if p is None or magnitude == 0.0:
-            continue
-        for sign in (1.0, -1.0):                   # right drum, then its mirror
-            m = np.array([1.0, sign, 1.0])
-            tip, force = p * m, f * m
-            shafts.append(np.column_stack([tip - force * ARROW_MM_PER_N / MM, tip]))
-            size.append(magnitude)
-            for k, v in zip("xyz", _mm(tip)):
-                heads[k].append(v)
-            for k, v in zip("uvw", force):
-                heads[k].append(round(float(v), 2))
-    return shafts, size, heads
-
-
 def _dynamic(run: RunFrames, k: int, scene: str, cmax: float,
              x_range: tuple[float, float]) -> list[dict]:
-    """The traces of run's frame k that change in time: stripes, bird,
-    fingers (one trace per finger of the right drum, with its mirror image
-    on the left; colours as in the report's figures), arrow shafts and
-    heads."""
-    frame = run.frames[k]
+    """The traces of run's frame k (its last, for a run that ended sooner)
+    that change in time: stripes, bird, fingers (one trace per finger of
+    the right drum, with its mirror image on the left; colours as in the
+    report's figures), arrow shafts and heads."""
+    frame = run.frames[min(k, len(run.frames) - 1)]
     traces = []
     sx, sy, sz = _polylines(stripes(run, frame.belt_travel, x_range))
     traces.append({"type": "scatter3d", "scene": scene, "mode": "lines", "x": sx, "y": sy,
@@ -93,9 +73,12 @@ def _dynamic(run: RunFrames, k: int, scene: str, cmax: float,
                        "z": z, "name": f"finger {name}", "legendgroup": name,
                        "showlegend": scene == "scene", "hoverinfo": "name",
                        "line": {"color": COLOURS[j % len(COLOURS)], "width": 5}})
-    shafts, size, heads = _arrows(frame)
-    x, y, z = _polylines(shafts)
-    colours = [v for s in size for v in (s, s, s)]
+    drawn = arrows(frame)
+    x, y, z = _polylines([np.column_stack([tail, tip]) for tail, tip, _, _ in drawn])
+    colours = [v for *_, size in drawn for v in (size, size, size)]
+    heads = {k: _mm([tip[i] for _, tip, _, _ in drawn]) for i, k in enumerate("xyz")}
+    heads.update({k: [round(float(f[i]), 2) for _, _, f, _ in drawn]
+                  for i, k in enumerate("uvw")})
     traces.append({"type": "scatter3d", "scene": scene, "mode": "lines", "x": x, "y": y, "z": z,
                    "name": "force on the bird", "showlegend": False, "hoverinfo": "skip",
                    "line": {"width": 9, "color": [round(c, 2) for c in colours] or [0.0],
@@ -127,7 +110,7 @@ def _static(run: RunFrames, scene: str, x_range: tuple[float, float], cmax: floa
 
 
 def _caption(run: RunFrames, k: int) -> str:
-    frame = run.frames[k]
+    frame = run.frames[min(k, len(run.frames) - 1)]
     touching = ", ".join(frame.touching(run.names)) or "none"
     return (f"<b>{run.label}</b>  t = {frame.t:.3f} s   N = {frame.normal:.2f} N"
             f"<br>touching the bird: {touching}")
@@ -149,16 +132,17 @@ def animation_figure(runs: list[RunFrames], step: float, cap: float | None) -> d
         first = len(data)
         data += _dynamic(run, 0, scene, cmax, x_range)
         dynamic += list(range(first, len(data)))
-    count = min(len(r.frames) for r in runs)
+    longest = max(runs, key=lambda r: len(r.frames))
     frames = [{"name": str(k), "traces": dynamic,
                "data": [_changing(t) for run, scene in zip(runs, scenes)
                         for t in _dynamic(run, k, scene, cmax, x_range)],
-               "layout": {"annotations": _annotations(runs, k)}} for k in range(count)]
+               "layout": {"annotations": _annotations(runs, k)}}
+              for k in range(len(longest.frames))]
     layout = {"height": HEIGHT, "margin": {"l": 0, "r": 0, "t": 60, "b": 0},
               "legend": {"x": 1.0, "xanchor": "left", "y": 0.5, "yanchor": "top",
                          "font": {"size": 11}},
               "annotations": _annotations(runs, 0),
-              "updatemenus": [_buttons(step)], "sliders": [_slider(runs[0], count)]}
+              "updatemenus": [_buttons(step)], "sliders": [_slider(longest)]}
     width = 1.0 / len(runs)
     for i, scene in enumerate(scenes):
         layout[scene] = _scene(box, (i * width, (i + 1) * width))
@@ -207,11 +191,12 @@ def _buttons(step: float) -> dict:
             "yanchor": "top", "pad": {"t": 45}, "showactive": False, "buttons": play + [pause]}
 
 
-def _slider(run: RunFrames, count: int) -> dict:
-    steps = [{"label": f"{run.frames[k].t:.3f}", "method": "animate",
+def _slider(run: RunFrames) -> dict:
+    """One step per frame of ``run`` (the longest), labelled with its time."""
+    steps = [{"label": f"{f.t:.3f}", "method": "animate",
               "args": [[str(k)], {"frame": {"duration": 0, "redraw": True},
                                   "transition": {"duration": 0}, "mode": "immediate"}]}
-             for k in range(count)]
+             for k, f in enumerate(run.frames)]
     return {"active": 0, "steps": steps, "x": 0.3, "len": 0.7, "y": 0.0, "yanchor": "top",
             "pad": {"t": 30}, "currentvalue": {"prefix": "t = ", "suffix": " s",
                                                "font": {"color": "#222"}},
