@@ -84,7 +84,7 @@ def _dynamic(run: RunFrames, k: int, scene: str, cmax: float,
                    "line": {"width": 9, "color": [round(c, 2) for c in colours] or [0.0],
                             "colorscale": FORCE_SCALE, "cmin": 0.0, "cmax": cmax}})
     traces.append({"type": "cone", "scene": scene, **heads, "anchor": "tip",
-                   "sizemode": "raw", "sizeref": 0.35 * ARROW_MM_PER_N, "cmin": 0.0,
+                   "sizemode": "raw", "sizeref": 0.2 * ARROW_MM_PER_N, "cmin": 0.0,
                    "cmax": cmax, "colorscale": FORCE_SCALE, "showscale": False,
                    "hoverinfo": "skip", "name": "force"})
     return traces
