@@ -175,17 +175,17 @@ def stripes(run: RunFrames, travel: float, x_range: tuple[float, float]) -> list
 
 
 def extent(runs: list[RunFrames]) -> np.ndarray:
-    """The box drawn (3, 2), in m: the grasper's drums and fingers over the
-    runs, widened by the bird's largest semi-axis and up to the bird's
-    highest point; the bird is clipped where it is outside (upstream)."""
+    """The box drawn (3, 2), in m: the drums, the fingers and the bird over
+    every frame of the runs (the bird's centre widened by its largest
+    semi-axis), and the belt."""
     pts = []
     for run in runs:
-        pts += [drum_surface(run.setup, 1).reshape(3, -1)]
+        b = run.setup.bird
+        reach = max(b.eta, b.lam, b.gamma)
+        centres = np.array([[f.y[0], 0.0, f.y[1]] for f in run.frames]).T
+        pts += [drum_surface(run.setup, 1).reshape(3, -1), centres - reach, centres + reach]
         pts += [np.hstack(both_drums(f.curves)) for f in run.frames]
     allp = np.hstack(pts)
-    reach = max(max(r.setup.bird.eta, r.setup.bird.lam, r.setup.bird.gamma) for r in runs)
-    lo, hi = allp.min(axis=1) - reach, allp.max(axis=1) + reach
-    lo[2] = min(allp[2].min(), 0.0) - 0.01
-    top = max(f.y[1] + r.setup.bird.eta for r in runs for f in r.frames)
-    hi[2] = max(allp[2].max(), top) + 0.01
+    lo, hi = allp.min(axis=1) - 0.01, allp.max(axis=1) + 0.01
+    lo[2] = min(lo[2], -0.01)
     return np.column_stack([lo, hi])

@@ -27,6 +27,7 @@ FORCE_COLOURS = LinearSegmentedColormap.from_list("force", [(p, c) for p, c in F
 
 
 def ffmpeg_available() -> bool:
+    """Whether matplotlib finds ffmpeg to write MP4."""
     return animation.writers.is_available("ffmpeg")
 
 
@@ -40,10 +41,10 @@ def write_video(runs: list[RunFrames], step: float, cap: float | None, path: Pat
     norm = Normalize(0.0, cap if cap is not None else max(peak, 1.0))
     box = extent(runs) * MM
     fig = Figure(figsize=(6.4 * len(runs) + 1.2, 5.4), dpi=100)
-    fig.subplots_adjust(left=0.0, right=0.9, bottom=0.0, top=0.92, wspace=0.0)
+    fig.subplots_adjust(left=0.02, right=0.86, bottom=0.02, top=0.92, wspace=0.12)
     axes = [fig.add_subplot(1, len(runs), i + 1, projection="3d") for i in range(len(runs))]
     fig.colorbar(ScalarMappable(norm=norm, cmap=FORCE_COLOURS),
-                 cax=fig.add_axes((0.92, 0.25, 0.015, 0.5)),
+                 cax=fig.add_axes((0.93, 0.25, 0.015, 0.5)),
                  label="force on the bird (N)" + (" (top: the cap)" if cap is not None else ""))
 
     def draw(k: int):
@@ -83,7 +84,7 @@ def _draw(ax, run: RunFrames, k: int, box: np.ndarray, norm: Normalize) -> None:
     ax.set_xlim(*box[0])
     ax.set_ylim(*box[1])
     ax.set_zlim(*box[2])
-    ax.set_box_aspect(box[:, 1] - box[:, 0], zoom=1.3)
+    ax.set_box_aspect(box[:, 1] - box[:, 0], zoom=1.1)
     ax.set_proj_type("ortho")
     ax.view_init(ELEVATION, AZIMUTH)
     ax.set_xlabel("X (mm)")

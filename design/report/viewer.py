@@ -26,7 +26,7 @@ from design.report.grasp_figures import COLOURS, MM
 SPEEDS = (0.1, 0.25, 1.0)
 #: the box's longest side in plotly's aspect ratio units: the zoom of its
 #: orthographic view, which scales with the aspect ratio
-ZOOM = 3.0
+ZOOM = 2.4
 #: height of a scene (px)
 HEIGHT = 720
 
