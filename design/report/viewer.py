@@ -32,10 +32,13 @@ HEIGHT = 720
 
 
 def _mm(a, digits: int = 1) -> list:
-    """Coordinates (m) as mm rounded to ``digits`` decimals; nan as None
-    (plotly's line breaks)."""
-    return [None if not np.isfinite(v) else round(float(v) * MM, digits) or 0
-            for v in np.asarray(a, float).ravel()]
+    """Coordinates (m) as mm rounded to ``digits`` decimals (whole mm as
+    integers); nan as None (plotly's line breaks)."""
+    mm = np.round(np.asarray(a, float).ravel() * MM, digits) + 0.0     # no -0.0
+    gaps = np.isnan(mm)
+    if not gaps.any():
+        return (mm.astype(int) if digits == 0 else mm).tolist()
+    return [None if gap else v for gap, v in zip(gaps, mm.tolist())]
 
 
 def _polylines(curves: list[np.ndarray]) -> tuple[list, list, list]:
