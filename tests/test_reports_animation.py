@@ -59,8 +59,7 @@ def test_frame_states_interpolate_the_records():
     t = np.array([0.0, 0.013, 0.05, 0.21, 0.5, 0.77, 1.0])
     columns = {"t_s": t, "X_m": -0.3 + 0.4 * t, "Z_m": 0.05 + 0 * t, "theta_rad": 0.1 * t,
                "Xdot_m_s": 0.4 + 0 * t, "Zdot_m_s": 0 * t, "thetadot_rad_s": 0.1 + 0 * t,
-               "N_N": 10 * t, "belt_speed_m_s": np.where(t <= 0.5, 0.5, 0.3)}
-    columns["belt_speed_m_s"] = np.interp(t, [0.0, 0.5, 1.0], [0.5, 0.5, 0.3])
+               "N_N": 10 * t, "belt_speed_m_s": np.interp(t, [0.0, 0.5, 1.0], [0.5, 0.5, 0.3])}
     states = frame_states(columns, 0.02)
     times = np.array(states["t_s"])
     assert len(times) == 51 and np.allclose(np.diff(times), 0.02)
