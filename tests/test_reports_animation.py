@@ -292,8 +292,9 @@ def test_the_report_plays_offline_and_draws_the_bird_where_the_time_series_puts_
         seen = []
         for k in STEPPED:
             page.evaluate(f"Plotly.animate('animation-view', ['{k}'], {{mode: 'immediate', "
-                          "frame: {duration: 0, redraw: true}, transition: {duration: 0}})")
-            page.wait_for_timeout(500)
+                          "frame: {duration: 0, redraw: true}, transition: {duration: 0}})"
+                          ".then(() => new Promise(done => requestAnimationFrame("
+                          "() => requestAnimationFrame(done))))")
             shot = page.locator("#animation-view").screenshot()
             seen.append(_bird_pixels(shot))
         browser.close()
