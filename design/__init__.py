@@ -1,9 +1,10 @@
 """Optimal design and timing of compliant graspers.
 
 The package's API: :func:`simulate` solves a scene file (or its content),
-:func:`check` validates a file, :func:`design.api.solve` optimises a design
-problem (``design.solve`` is the solvers' subpackage). The command ``design``
-wraps them.
+:func:`check` validates a file, :func:`animate` writes a run's 3-D
+animation from its output folder, :func:`design.api.solve` optimises a
+design problem (``design.solve`` is the solvers' subpackage). The command
+``design`` wraps them.
 """
 
 import os as _os
@@ -16,14 +17,14 @@ __version__ = "0.1.0"
 # setting wins; it has no effect if numpy was imported before this package.
 _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-__all__ = ["check", "simulate", "__version__"]
+__all__ = ["animate", "check", "simulate", "__version__"]
 
 
 def __getattr__(name: str):
-    """``design.check`` and ``design.simulate``, imported on first use: a
+    """``design.animate``, ``design.check`` and ``design.simulate``, imported on first use: a
     process that needs only part of the toolkit (a study's worker, ``design
     --version``) does not load the solvers, reports and plotting (1.5 s)."""
-    if name in ("check", "simulate"):
+    if name in ("animate", "check", "simulate"):
         from design import api
         return getattr(api, name)
     raise AttributeError(f"module 'design' has no attribute {name!r}")

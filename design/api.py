@@ -116,6 +116,20 @@ def _run_and_write(scene: object, source: str | Path | Mapping, out: str | Path 
     return output.result
 
 
+def animate(result_dir: str | Path, out: str | Path | None = None, speed: float = 0.25,
+            progress: Progress | None = None) -> Path:
+    """Write the 3-D animation of the grasp or design run whose output folder
+    is ``result_dir`` from its result.json (``design animate``): ``out``
+    ending .mp4 (needs ffmpeg), .gif or .html; None: RESULT_DIR/animation.mp4,
+    or .gif without ffmpeg. Videos play at ``speed`` times real time. The
+    fingers are solved again at the frame states the result keeps. Returns
+    the file written; raises :class:`design.report.animate.AnimateError`
+    (nothing written) for a result or output that will not do."""
+    from design.report.animate import animate as write_animation
+
+    return write_animation(result_dir, out, speed, progress)
+
+
 def check(source: str | Path | Mapping) -> object:
     """Validate any input file (scene or model); returns the object it describes."""
     return check_file(source)

@@ -51,6 +51,18 @@ def default_folder(scene: object, source: str) -> Path:
     return Path("reports") / (scene.name or Path(source).stem)
 
 
+def speed_fraction(text: str) -> float:
+    """``--speed``: a playback speed in (0, 10], a fraction of real time."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = 0.0
+    if not 0.0 < value <= 10.0:
+        raise argparse.ArgumentTypeError(f"a fraction of real time in (0, 10], not {text!r}. "
+                                         f"Nothing was written")
+    return value
+
+
 def workers_count(text: str) -> int:
     """``--workers``: an integer >= 1."""
     try:
@@ -220,6 +232,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", help="output folder (default: reports/<problem name>/)")
     p.add_argument("--quiet", action="store_true", help="no progress messages")
     p.set_defaults(func=_lazy("design.fit.command", "cmd_fit"))
+    p = sub.add_parser("animate", help="write a grasp or design run's 3-D animation from its "
+                       "result folder: MP4 (with ffmpeg) or GIF, or the interactive HTML view")
+    p.add_argument("result_dir", metavar="RESULT_DIR", help="a run's output folder (its "
+                   "result.json)")
+    p.add_argument("--out", metavar="FILE", help="FILE.mp4, FILE.gif or FILE.html (default: "
+                   "RESULT_DIR/animation.mp4, or .gif without ffmpeg)")
+    p.add_argument("--speed", type=speed_fraction, default=0.25,
+                   help="a video's playback speed, a fraction of real time (default 0.25)")
+    p.add_argument("--quiet", action="store_true", help="no progress messages")
+    p.set_defaults(func=_lazy("design.report.animate", "cmd_animate"))
     p = sub.add_parser("check", help="validate input files and report every problem")
     p.add_argument("files", nargs="+", help="scene, problem or model files (YAML)")
     p.set_defaults(func=cmd_check)

@@ -16,6 +16,8 @@ import os
 import sys
 import warnings
 
+import pytest
+
 for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ.setdefault(_variable, "1")
 
@@ -99,6 +101,21 @@ def _prefetch_jobs(session) -> list:
     if fixture_used("mean_hard"):
         jobs.append((MEAN_HARD, mean_bird_run, ("hard",), ()))
     return jobs
+
+
+@pytest.fixture(scope="session")
+def design_run(tmp_path_factory):
+    """tests/test_reports.py's :func:`solve_short_design`: its status, output
+    folder and the designs it handed the model check; run ahead by the
+    session's prefetch worker (tests/prefetch.py) into the folder it was
+    given, or here. Shared by the report and animation tests."""
+    from tests import prefetch
+    from tests.test_reports import DESIGN_RUN, solve_short_design
+
+    given = prefetch.scheduled(DESIGN_RUN)
+    tmp = given[0] if given else tmp_path_factory.mktemp("design")
+    status, checked = prefetch.result(DESIGN_RUN, solve_short_design, tmp)
+    return status, tmp / "out", checked
 
 
 def pytest_sessionfinish(session):

@@ -24,7 +24,6 @@ from design.solve.contact.spatial import Quadric, SpatialContact
 from design.solve.grasp.fingers import FingerState
 from design.solve.optimize.model_check import compare
 from design.solve.optimize.trust_region import LOOP_SIMULATOR
-from tests import prefetch
 from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
@@ -142,7 +141,7 @@ def test_grasp_report(tmp_path):
                      "--quiet"]) == 0
     out = tmp_path / "out"
     r, result = read(out), json.loads((out / "result.json").read_text())
-    assert r.sections == ["scene", "summary", *GRASP_SECTIONS, "reproduce"]
+    assert r.sections == ["scene", "summary", "animation", *GRASP_SECTIONS, "reproduce"]
     assert list(r.figures) == GRASP_FIGURES
     s = result["summary"]
     rows = dict(zip(r.column("summary-table", "quantity"), r.column("summary-table", "value")))
@@ -203,22 +202,11 @@ def solve_short_design(tmp: Path) -> tuple[int, list]:
     return status, RecordingCheck.submitted
 
 
-@pytest.fixture(scope="module")
-def design_run(tmp_path_factory):
-    """:func:`solve_short_design`'s status, output folder and the designs it
-    handed the model check: run ahead by the session's prefetch worker
-    (tests/prefetch.py) into the folder it was given, or here."""
-    given = prefetch.scheduled(DESIGN_RUN)
-    tmp = given[0] if given else tmp_path_factory.mktemp("design")
-    status, checked = prefetch.result(DESIGN_RUN, solve_short_design, tmp)
-    return status, tmp / "out", checked
-
-
 def test_design_report_has_every_section_and_matches_result(design_run):
     status, out, checked = design_run
     r, result = read(out), json.loads((out / "result.json").read_text())
     check_ran = result["status"] in ("verified", "failed verification")  # an optimum to check
-    assert r.sections == ["problem", "verification", *GRASP_SECTIONS,
+    assert r.sections == ["problem", "verification", "animation", *GRASP_SECTIONS,
                           *(["model-check"] if check_ran else []), "convergence", "reproduce"]
     assert list(r.figures) == GRASP_FIGURES + ["fig-convergence"]
     passed = result["verification"]["passed"]

@@ -28,8 +28,8 @@ def finger_spec(finger: Finger) -> dict:
             p = dict(st.describe())
             modulus = p.pop("E")
             out[key] = {"type": p.pop("type"), **p}
-            if key == "J":
-                out["poisson"] = E / (2 * modulus) - 1
+            if key == "J":       # rounded: a scaled rubber's 0.5 reads back as 0.5
+                out["poisson"] = round(E / (2 * modulus) - 1, 12)
     return out
 
 

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from design.report.grasp import grasp_figures, reproduce_section, summary_rows
+from design.report.grasp import (animation_section, grasp_figures, reproduce_section,
+                                 summary_rows)
 from design.report.page import Page
 from design.solve.grasp.simulation import GraspRun
 from design.solve.optimize.model_check import check_text
@@ -192,6 +193,7 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
                "verification-table")
     page.table(summary_rows(baseline, "baseline") + summary_rows(optimum, "optimum"),
                "Baseline and optimum, both from the independent simulation", "summary-table")
+    animation_section(page, result)
     grasp_figures(page, {"baseline": baseline, "optimum": optimum}, v["cap_N"])
     if result.get("model_check"):
         model_check_section(page, result["model_check"])

@@ -6,6 +6,7 @@ import numpy as np
 
 from design.report import grasp_figures as gf
 from design.report.page import Page
+from design.report.animation import ARROW_MM_PER_N
 from design.solve.grasp.simulation import GraspRun
 
 
@@ -26,6 +27,39 @@ def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
                      s["local_error_estimate"]["position_m"], "m"))
     return [{"quantity": q, **({"run": label} if label else {}), "value": v, "unit": u}
             for q, v, u in rows]
+
+
+def animation_section(page: Page, result: dict) -> None:
+    """The 3-D animation of the result's runs (its ``animation`` entry),
+    the fingers solved again at every frame; where a contact cannot be
+    solved, the reason instead."""
+    from design.errors import ProblemFileError
+    from design.report.animation import animated_runs
+    from design.solve.grasp.fingers import ContactFailed
+
+    page.section("Animation", "animation")
+    try:
+        runs = animated_runs(result["animation"])
+    except (ContactFailed, ProblemFileError) as exc:
+        page.text(f"No animation: {exc}.")
+        return
+    animation_view(page, runs, result["animation"])
+
+
+def animation_view(page: Page, runs: list, record: dict) -> None:
+    """The interactive view of ``runs`` (RunFrames) and what it shows."""
+    from design.report.viewer import animation_html
+
+    step, cap = record["frame_step_s"], record["cap_N"]
+    recorded = ", ".join(f"{r.label} {r.recorded}" for r in runs)
+    page.text(f"Frames every {1e3 * step:g} ms ({len(runs[0].frames)} frames; the bird's state "
+              f"interpolated linearly between the run's recorded instants: {recorded}); at "
+              f"each frame every finger's contact is solved again at that state. Arrows: each "
+              f"finger's force on the bird, {ARROW_MM_PER_N:g} mm per N, coloured "
+              + (f"against the cap of {cap:.2f} N." if cap is not None else
+                 "from no force to the largest drawn (no cap).")
+              + " Drag to turn the view, scroll to zoom; a finger's legend entry hides it.")
+    page.fragment(animation_html(runs, step, cap))
 
 
 def grasp_figures(page: Page, runs: dict[str, GraspRun], cap: float | None = None) -> None:
@@ -75,6 +109,7 @@ def grasp_page(result: dict, run: GraspRun) -> Page:
                "Fingers of the right drum (m, rad)")
     page.section("Summary", "summary")
     page.table(summary_rows(run), "Run summary (SI)", "summary-table")
+    animation_section(page, result)
     grasp_figures(page, {"": run})
     reproduce_section(page, result,
                       [{"setting": k, "value": v} for k, v in result["solver"].items()],

@@ -9,8 +9,9 @@ drum's fingers are listed; the left drum mirrors them (Y → -Y).
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from matplotlib.patches import Circle, Rectangle
+from matplotlib.patches import Polygon
 from matplotlib.patches import Ellipse as EllipsePatch
 
 from design.physics.contact import ContactSolution
@@ -18,6 +19,8 @@ from design.solve.contact.spatial import SpatialSolution
 from design.solve.grasp.simulation import GraspRun, GraspSetup
 
 MM = 1e3
+#: height (mm of the side view) kept above the birds for each key instant's label
+LABEL_MM = 25.0
 #: one colour per finger, in grasper order
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2",
            "#7f7f7f", "#bcbd22", "#17becf"]
@@ -47,6 +50,21 @@ def _finger_points(sol, length: float) -> np.ndarray:
     return np.vstack([np.linspace(0.0, length, 2), np.zeros((2, 2))])
 
 
+def drum_profile(setup: GraspSetup) -> list[tuple[float, float]]:
+    """The right drum's outline as (height m, radius m) pairs, bottom to top:
+    the radius at each height a finger is mounted (the largest where
+    several are); one height gives a disc 10 mm thick."""
+    rings: dict[float, float] = {}
+    for gf in setup.grasper.fingers:
+        h = gf.mount.height
+        rings[h] = max(rings.get(h, 0.0), gf.mount.radius)
+    profile = sorted(rings.items())
+    if len(profile) == 1:
+        (h, r), = profile
+        profile = [(h - 0.005, r), (h + 0.005, r)]
+    return profile
+
+
 def _bird_outline(setup: GraspSetup, y: np.ndarray, plane: str) -> EllipsePatch:
     """The bird's outline (mm) in the side (X-Z) or front (Y-Z) view."""
     b = setup.bird
@@ -57,24 +75,57 @@ def _bird_outline(setup: GraspSetup, y: np.ndarray, plane: str) -> EllipsePatch:
                         color="k", lw=1.2)
 
 
+def split_at_belt(curve: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A finger's points (3, n) as its part above the belt (Z ≥ 0) and its
+    part below, each (3, m) with nan where the other part is (a line
+    break), and the points (3, k) where it crosses the belt."""
+    z = curve[2]
+    points, crossings = [curve[:, :1]], []
+    for i in range(curve.shape[1] - 1):
+        if (z[i] < 0.0) != (z[i + 1] < 0.0):
+            s = z[i] / (z[i] - z[i + 1])
+            cross = curve[:, i] + s * (curve[:, i + 1] - curve[:, i])
+            points.append(cross[:, None])
+            crossings.append(cross)
+        points.append(curve[:, i + 1:i + 2])
+    full = np.hstack(points)
+    above, below = full.copy(), full.copy()
+    above[:, full[2] < -1e-12] = np.nan
+    below[:, full[2] > 1e-12] = np.nan
+    return above, below, np.array(crossings).T.reshape(3, -1)
+
+
 def _draw_fingers(ax, curves, axes: tuple[int, int], style: str = "-", alpha: float = 1.0,
                   label_prefix: str = "", names=None) -> None:
-    """Right-drum fingers and their left mirror images projected on two world axes."""
+    """Right-drum fingers and their left mirror images projected on two world
+    axes; where Z is drawn, a finger's part below the belt dotted and its
+    crossing of the belt marked x."""
+    below_label = "finger meets the belt (below it: dotted)"
     for i, c in enumerate(curves):
         colour = COLOURS[i % len(COLOURS)]
         label = f"{label_prefix}finger {names[i]}" if names else None
-        ax.plot(c[axes[0]] * MM, c[axes[1]] * MM, style, color=colour, alpha=alpha, lw=2,
-                label=label)
-        if 1 in axes:       # the mirror image is distinct only where Y is drawn
-            m = c * np.array([[1.0], [-1.0], [1.0]])
-            ax.plot(m[axes[0]] * MM, m[axes[1]] * MM, style, color=colour, alpha=alpha * 0.5,
-                    lw=2)
+        mirrors = [c] + ([c * np.array([[1.0], [-1.0], [1.0]])] if 1 in axes else [])
+        for k, m in enumerate(mirrors):     # the mirror image is distinct only where Y is drawn
+            shade = alpha * (0.5 if k else 1.0)
+            if 2 not in axes:
+                ax.plot(m[axes[0]] * MM, m[axes[1]] * MM, style, color=colour, alpha=shade,
+                        lw=2, label=None if k else label)
+                continue
+            above, below, crossings = split_at_belt(m)
+            ax.plot(above[axes[0]] * MM, above[axes[1]] * MM, style, color=colour, alpha=shade,
+                    lw=2, label=None if k else label)
+            if crossings.size:
+                ax.plot(below[axes[0]] * MM, below[axes[1]] * MM, ":", color=colour,
+                        alpha=shade, lw=1.5)
+                listed = below_label in ax.get_legend_handles_labels()[1]
+                ax.plot(crossings[axes[0]] * MM, crossings[axes[1]] * MM, "x", color="k",
+                        ms=6, label=None if listed else below_label)
 
 
 def layout_figure(setups: dict[str, GraspSetup], t: float = 0.0) -> Figure:
     """The fingers as mounted (straight, unloaded) at time t, in top (X-Y),
     side (X-Z) and front (Y-Z) views; one line style per design."""
-    fig = Figure(figsize=(13, 4.4))
+    fig = Figure(figsize=(13, 5.2), layout="constrained")
     axes = fig.subplots(1, 3)
     styles = ["-", "--", ":"]
     for k, (label, setup) in enumerate(setups.items()):
@@ -84,16 +135,10 @@ def layout_figure(setups: dict[str, GraspSetup], t: float = 0.0) -> Figure:
         for ax, pair in zip(axes, [(0, 1), (0, 2), (1, 2)]):
             _draw_fingers(ax, curves, pair, styles[k % 3], 1.0 if k == 0 else 0.8,
                           "", names if ax is axes[0] else None)
-        radius = max(f.mount.radius for f in g.fingers)
-        low, high = (min(f.mount.height for f in g.fingers), max(f.mount.height for f in g.fingers))
-        for side in (-1, 1):
-            centre = side * g.spacing / 2
-            outline = dict(fill=False, ls=styles[k % 3], color="0.4")
-            axes[0].add_patch(Circle((g.x * MM, centre * MM), radius * MM, **outline))
-            axes[2].add_patch(Rectangle(((centre - radius) * MM, low * MM), 2 * radius * MM,
-                                        (high - low) * MM, **outline))
-        axes[1].add_patch(Rectangle(((g.x - radius) * MM, low * MM), 2 * radius * MM,
-                                    (high - low) * MM, fill=False, ls=styles[k % 3], color="0.4"))
+        outline = dict(fill=False, ls=styles[k % 3], color="0.4")
+        for view, ax in zip(("top", "side", "front"), axes):
+            for points in drum_outlines(setup, view):
+                ax.add_patch(Polygon((points * MM).T, closed=True, **outline))
         axes[0].plot([], [], styles[k % 3], color="0.2", label=label)
     for ax, (xl, yl), title in zip(axes, [("X", "Y"), ("X", "Z"), ("Y", "Z")],
                                    ["top view", "side view", "front view"]):
@@ -102,8 +147,30 @@ def layout_figure(setups: dict[str, GraspSetup], t: float = 0.0) -> Figure:
         ax.set_title(f"{title}, t = {t:.2f} s")
         ax.set_aspect("equal", adjustable="datalim")
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=7, loc="best")
+    entries = {lab: h for ax in axes for h, lab in zip(*ax.get_legend_handles_labels())}
+    fig.legend(list(entries.values()), list(entries), loc="outside lower center", ncol=9,
+               fontsize=7)
     return fig
+
+
+def drum_outlines(setup: GraspSetup, view: str) -> list[np.ndarray]:
+    """Both drums' outlines (2, n) in m, as seen in the ``top`` (X-Y), ``side``
+    (X-Z) or ``front`` (Y-Z) view: the largest ring from above, the profile
+    through the rings (:func:`drum_profile`) from the side (tilted with the
+    axis) and the front; the drums coincide in the side view."""
+    g = setup.grasper
+    profile = drum_profile(setup)
+    if view == "top":
+        a = np.linspace(0.0, 2 * np.pi, 73)
+        r = max(radius for _, radius in profile)
+        return [np.vstack([g.x + r * np.cos(a), side * g.spacing / 2 + r * np.sin(a)])
+                for side in (-1, 1)]
+    h = np.array([p[0] for p in profile] + [p[0] for p in reversed(profile)])
+    r = np.array([p[1] for p in profile] + [-p[1] for p in reversed(profile)])
+    if view == "side":
+        c, s = np.cos(g.tilt), np.sin(g.tilt)
+        return [np.vstack([g.x + c * r + s * h, -s * r + c * h])]
+    return [np.vstack([side * g.spacing / 2 + r, h]) for side in (-1, 1)]
 
 
 def key_instants(run: GraspRun) -> list[tuple[float, str]]:
@@ -127,6 +194,34 @@ def _record_at(run: GraspRun, t: float):
     return recs[int(np.argmin([abs(r.t - t) for r in recs]))]
 
 
+def _instants_drawn(run: GraspRun) -> list:
+    """The records at the key instants, those at one record merged: (record,
+    the instants' names)."""
+    drawn: dict[int, tuple] = {}
+    for tk, name in key_instants(run):
+        r = _record_at(run, tk)
+        drawn.setdefault(id(r), (r, []))[1].append(name)
+    return list(drawn.values())
+
+
+def _stack(ax, labels: list) -> None:
+    """Raise each label (an annotation placed in offset points) above the
+    ones before it that it would overlap, once the figure is laid out (the
+    labels take no part in the layout)."""
+    for label in labels:
+        label.set_in_layout(False)
+    renderer = FigureCanvasAgg(ax.figure).get_renderer()
+    ax.figure.draw_without_rendering()
+    placed = []
+    for label in labels:
+        box = label.get_window_extent(renderer)
+        while (hit := next((b for b in placed if box.overlaps(b)), None)) is not None:
+            dx, dy = label.xyann
+            label.xyann = (dx, dy + (hit.y1 - box.y0 + 2) * 72 / ax.figure.dpi)
+            box = label.get_window_extent(renderer)
+        placed.append(box)
+
+
 def path_figure(run: GraspRun) -> Figure:
     """Side view of the bird's path with the bird and the deflected fingers
     at the key instants; its height and pitch against time."""
@@ -134,23 +229,29 @@ def path_figure(run: GraspRun) -> Figure:
     recs = run.trajectory.records
     t = np.array([r.t for r in recs])
     y = np.array([r.y for r in recs])
-    instants = key_instants(run)
     fig = Figure(figsize=(13, 8))
     top = fig.add_subplot(2, 1, 1)
     top.plot(y[:, 0] * MM, y[:, 1] * MM, "k-", lw=1, label="bird centre")
-    for k, (tk, name) in enumerate(instants):
-        r = _record_at(run, tk)
+    labels = []
+    for k, (r, names) in enumerate(_instants_drawn(run)):
         top.add_patch(_bird_outline(setup, r.y, "side"))
         _draw_fingers(top, finger_curves(setup, r.t, r.fingers), (0, 2), alpha=0.9,
                       names=[f.name for f in setup.grasper.fingers] if k == 0 else None)
-        top.annotate(f"{name}\nt = {r.t:.3f} s", (r.y[0] * MM, (r.y[1] + setup.bird.gamma) * MM),
-                     ha="center", va="bottom", fontsize=8)
+        labels.append(top.annotate(f"{', '.join(names)}\nt = {r.t:.3f} s",
+                                   (r.y[0] * MM, (r.y[1] + setup.bird.gamma) * MM),
+                                   xytext=(0, 4), textcoords="offset points", ha="center",
+                                   va="bottom", fontsize=8))
     top.axhline(0.0, color="0.3", lw=3, label="belt")
     top.set_aspect("equal", adjustable="datalim")
     top.set_xlabel("X (mm)")
     top.set_ylabel("Z (mm)")
     top.set_title("side view: the bird and the right drum's fingers at key instants")
-    top.legend(fontsize=7, ncol=3, loc="upper left")
+    top.legend(fontsize=7, ncol=2, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    # room above the birds for the labels, stacked
+    top.update_datalim([(MM * y[0, 0], MM * (y[:, 1].max() + setup.bird.eta)
+                         + LABEL_MM * len(labels))])
+    top.autoscale_view()
+    _stack(top, labels)
     ax1 = fig.add_subplot(2, 2, 3)
     ax1.plot(t, (y[:, 1] - y[0, 1]) * MM)
     ax1.set_xlabel("t (s)")

@@ -99,6 +99,10 @@ class Page:
         self.parts.append(f"<table{ident}>{cap}<thead><tr>{head}</tr></thead>"
                           f"<tbody>{body}</tbody></table>")
 
+    def fragment(self, html_text: str) -> None:
+        """An HTML fragment made elsewhere (an interactive figure), as it is."""
+        self.parts.append(html_text)
+
     def figure(self, fig, name: str, caption: str) -> None:
         """Render a matplotlib figure to PNG, embed it and keep it as ``name``.png."""
         buf = io.BytesIO()

@@ -8,7 +8,9 @@ import numpy as np
 
 from design import __version__
 from design.io.grasp_scene import GraspScene
+from design.io.scene_writer import grasp_spec
 from design.run import Progress, RunOutput
+from design.run.animation import animation_record
 from design.solve.grasp.simulation import GraspRun, GraspSetup, simulate_grasp
 from design.solve.grasp.validity import validity_problems
 
@@ -72,6 +74,8 @@ def result_dict(scene: GraspScene, r: GraspRun) -> dict:
                    "contact_nodes": scene.settings.contact_nodes,
                    "reach_filter": scene.settings.reach_filter},
         "summary": r.summary,
+        "animation": animation_record({scene.name or "grasp": (
+            grasp_spec(r.setup, scene.settings, scene.name, scene.description), rows)}, None),
         "stats": {"wall_time_s": traj.wall_time, "setup_time_s": r.setup_time,
                   "steps": traj.steps, "contact_solves": r.contact_solves,
                   "finger_evaluations_skipped": r.skipped,

@@ -27,8 +27,10 @@ import numpy as np
 from design import __version__
 from design.errors import StudyFailed
 from design.io.design_problem import DesignProblem
+from design.io.grasp_scene import GraspSettings
 from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
+from design.run.animation import animation_record
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.optimize.model_check import BASELINE, ModelCheck, check_text
@@ -399,7 +401,14 @@ def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], fin
     }
     if problem.pareto:
         result["pareto"] = sorted((_pareto_row(e) for e in entries), key=lambda r: r["cap_N"])
-    tables = {"design.csv": primary["variables"], "timeseries.csv": timeseries(fine.run)}
+    rows = {"baseline": timeseries(baseline.run), "optimum": timeseries(fine.run)}
+    result["animation"] = animation_record(
+        {label: (grasp_spec(run.setup, GraspSettings(problem.settings.simulator,
+                                                     problem.settings.contact_nodes),
+                            f"{problem.name}_{label}", ""), rows[label])
+         for label, run in (("baseline", baseline.run), ("optimum", fine.run))},
+        primary["verification"]["cap_N"])
+    tables = {"design.csv": primary["variables"], "timeseries.csv": rows["optimum"]}
     if problem.pareto:
         tables["pareto.csv"] = result["pareto"]
     files = {}
