@@ -33,6 +33,7 @@ from design.run import Progress, RunOutput
 from design.run.animation import animation_record
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
+from design.solve.reproducible import numerics, one_blas_thread
 from design.solve.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, SETUP, STUDY,
                                            VERIFICATION, Profile, clocks)
@@ -94,9 +95,10 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     tightest first within a start), verify, and pick per cap the best
     verified design; a population also gets its single-bird comparison.
     The cases run through design/study (``study``: where, and the case
-    store); a study of one chain runs in this process."""
-    with ModelCheck(problem.settings.simulator) if problem.model_check != "none" \
-            else nullcontext() as check:
+    store); a study of one chain runs in this process. Every BLAS runs one
+    thread (design/solve/reproducible.py): the same answer on any machine."""
+    with one_blas_thread(), ModelCheck(problem.settings.simulator) \
+            if problem.model_check != "none" else nullcontext() as check:
         return _run(problem, progress, study, check)
 
 
@@ -397,6 +399,7 @@ def _output(problem: DesignProblem, space: DesignSpace, entries: list[dict], fin
                      "max_finger_force_finger": baseline.run.summary["max_finger_force_finger"],
                      "design": {v.name: v.baseline for v in space.variables}},
         "model_check": model_check,
+        "numerics": numerics(),
         "wall_time_s": time.perf_counter() - t0,
     }
     if problem.pareto:

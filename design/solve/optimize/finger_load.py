@@ -424,6 +424,8 @@ class _Roots(ca.Callback):
         self.rootfinder, self.n_q = rootfinder, n_q
         self.n_z, self.n = rootfinder.size1_in(0), rootfinder.size2_in(0)
         self._memory: dict = {}
+        #: the last solution for each guess (the stages a call serves), to start from
+        self._last: dict = {}
         self.solves = self.reuses = 0
         self.construct(name, {"enable_fd": False})
 
@@ -450,13 +452,25 @@ class _Roots(ca.Callback):
         return ca.diagcat(*[ca.Sparsity.dense(self.n_z, self.n_q)] * self.n)
 
     def eval(self, arg):
-        key = np.asarray(arg[0]).tobytes() + np.asarray(arg[1]).tobytes()
+        guess = np.asarray(arg[0]).tobytes()
+        key = guess + np.asarray(arg[1]).tobytes()
         if key in self._memory:
             self.reuses += 1
             self._memory[key] = z = self._memory.pop(key)      # most recent last
             return [z]
-        z = self.rootfinder(arg[0], arg[1])
+        # from these stages' last solution, the nearest in the design; from the
+        # simulation's guess where that does not converge
+        last = self._last.get(guess)
+        z = None
+        if last is not None:
+            try:
+                z = self.rootfinder(last, arg[1])
+            except RuntimeError:
+                z = None
+        if z is None:
+            z = self.rootfinder(arg[0], arg[1])
         self.solves += 1
+        self._last[guess] = z
         self._memory[key] = z
         if len(self._memory) > self.ENTRIES:
             del self._memory[next(iter(self._memory))]

@@ -37,6 +37,7 @@ from design.interrupt import checkpoint
 from design.interrupt import requested as interrupt_requested
 from design.physics.bird import BirdDynamics, Loads, belt_motion
 from design.solve.grasp.validity import fold_force
+from design.solve.reproducible import IPOPT_ORDERING
 from design.solve.optimize.finger_load import FingerLoad
 from design.solve.optimize.schedule import STAGES, Schedule
 from design.solve.optimize.variables import DesignSpace, parameters_of
@@ -444,7 +445,7 @@ class DesignNLP:
         opts = {"ipopt": {"hessian_approximation": "limited-memory", "max_iter": s.max_iter,
                           "tol": s.tol, "acceptable_tol": 1e-4, "print_level": 0, "sb": "yes",
                           "max_wall_time": s.max_wall_time,
-                          "mu_strategy": "adaptive", **s.ipopt},
+                          "mu_strategy": "adaptive", **IPOPT_ORDERING, **s.ipopt},
                 "print_time": False, "iteration_callback": callback,
                 # each function's wall and CPU time and calls in stats(), for the run's profile
                 "record_time": True,
