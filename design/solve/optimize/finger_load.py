@@ -365,6 +365,13 @@ class FingerLoad:
         threads = min(self.model.threads, os.cpu_count() or 1)
         return f.map(n, "thread", threads) if threads > 1 and n > 1 else f.map(n)
 
+    def restart(self) -> None:
+        """Forget the contacts the batches solved: the next solve starts every
+        stage from the simulation's guess again (a rebound NLP then solves as
+        a new one)."""
+        for _, roots in self._batches.values():
+            roots.restart()
+
     @property
     def stage_solves(self) -> int:
         """Contacts solved so far by this finger's batches (stages x solves;
@@ -450,6 +457,10 @@ class _Roots(ca.Callback):
         if iind == 0:
             return ca.Sparsity(self.n_z * self.n, self.n_z * self.n)
         return ca.diagcat(*[ca.Sparsity.dense(self.n_z, self.n_q)] * self.n)
+
+    def restart(self) -> None:
+        self._memory.clear()
+        self._last.clear()
 
     def eval(self, arg):
         guess = np.asarray(arg[0]).tobytes()

@@ -122,6 +122,10 @@ class PopulationNLP(DesignNLP):
                          sorted({r for nlp in self.nlps for r in nlp.compiled[1]}))
         self._size, self._solver = None, None
 
+    def restart_contacts(self) -> None:
+        for nlp in self.nlps:
+            nlp.restart_contacts()
+
     @property
     def stage_solves(self) -> int:
         return sum(nlp.stage_solves for nlp in self.nlps)

@@ -386,6 +386,11 @@ class DesignNLP:
             margin, tag = (slip if phase.exact else phase.sign * slip), "stick starts"
         constrain(margin, 0.0 if phase.exact else -np.inf, 0.0, tag)
 
+    def restart_contacts(self) -> None:
+        """Every finger stage starts its next solve from the simulation's guess."""
+        for finger in self.fingers.values():
+            finger.restart()
+
     @property
     def stage_solves(self) -> int:
         """Finger contacts solved so far in this NLP's functions."""
@@ -428,6 +433,7 @@ class DesignNLP:
                 self._solver = callback, self._nlpsol(callback)
             callback, solver = self._solver
             callback.restart(history)
+        self.restart_contacts()
         solves = self.stage_solves
         try:
             with self._timed("solve"), _casadi_output_muted() as streams:
