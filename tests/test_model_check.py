@@ -28,7 +28,7 @@ def placed_bird(duration: float) -> DesignSpace:
     """The main problem's space (the mean bird placed on finger 4a), cut to
     ``duration`` s: 0.08 s is 1.6 s CPU of spatial rod and finger 4a presses
     about 30 N in it."""
-    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    space = design_space(load_scene(ROOT / "problems" / "hold_time_planar.yaml"))
     return DesignSpace(replace(space.baseline, duration=duration), space.variables)
 
 

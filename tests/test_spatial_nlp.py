@@ -29,7 +29,7 @@ PLACED_HOLD = "test_spatial_nlp: placed bird, 0.5 s"
 
 def placed_space(duration: float) -> DesignSpace:
     """The main problem's design space with the spatial finger, cut to ``duration`` s."""
-    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    space = design_space(load_scene(ROOT / "problems" / "hold_time_planar.yaml"))
     return DesignSpace(replace(space.baseline, duration=duration, finger_model="spatial"),
                        space.variables)
 
@@ -48,7 +48,7 @@ def placed():
     """The main problem's scene with the spatial finger, 0.04 s of it (0.6 s
     CPU): finger 4a presses the placed mean bird about 14 N (a record at
     0.034 s), sliding under it with µ = 0.4."""
-    space = design_space(load_scene(ROOT / "problems" / "hold_time.yaml"))
+    space = design_space(load_scene(ROOT / "problems" / "hold_time_planar.yaml"))
     setup = replace(space.baseline, duration=0.04, finger_model="spatial")
     return setup, simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)
 

@@ -57,7 +57,8 @@ DIMENSIONS = {"angle": "angle", "phi_x": "angle", "phi_y": "angle", "length": "l
 
 @dataclass(frozen=True)
 class Cap:
-    """The bruise cap: ``value`` N, or ``relative`` × the baseline's verified peak."""
+    """The bruise cap, one for every bird: ``value`` N, or ``relative`` × the
+    design bird's (the scene's own) verified baseline peak."""
 
     value: float | None = None
     relative: float | None = None

@@ -118,7 +118,9 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
         + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
         baseline = verify(population, d0, settings)
-    caps = [np.array([c.resolve(peak) for peak in baseline.peaks]) for c in problem.caps]
+    # one cap in newtons for every bird: ``baseline`` is the design bird's own peak
+    reference = design_bird_peak(population, space, baseline, settings)
+    caps = [np.full(len(population.members), c.resolve(reference)) for c in problem.caps]
     cases = design_cases(problem, space, population, caps)
     chains = sum(case.after is None for case in cases)
     options = study or StudyOptions(workers=1)
@@ -225,11 +227,20 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
                                     "caps_N": caps[k].tolist()}, after))
             after = key
     if problem.population:
-        names = [member.name for member in population.members]
-        own = space.baseline.bird.name
-        cap = caps[0][names.index(own)] if own in names else None
-        cases.append(Case(SINGLE_BIRD, {"single_bird": own, "cap_N": cap}))
+        cases.append(Case(SINGLE_BIRD, {"single_bird": space.baseline.bird.name,
+                                        "cap_N": float(caps[0][0])}))
     return cases
+
+
+def design_bird_peak(population: Population, space: DesignSpace, baseline: Scored,
+                     settings) -> float:
+    """The design bird's (the scene's own) baseline peak force (N): among the
+    population's verified baseline runs, else verified alone."""
+    names = [member.name for member in population.members]
+    own = space.baseline.bird.name
+    if own in names:
+        return float(baseline.peaks[names.index(own)])
+    return verify(Population.of(space), space.scale(space.base_values), settings).peak
 
 
 def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCheck | None,
@@ -278,8 +289,6 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
     settings = problem.settings
     own = Population.of(space)
     cap = case.inputs["cap_N"]
-    if cap is None:
-        cap = problem.caps[0].resolve(verify(own, space.scale(space.base_values), settings).peak)
     outcome = optimise(own, cap, settings, problem.rules)
     fine = verify(population, outcome.best.d, settings)
     _PROFILES[case.key] = outcome.profile
