@@ -18,6 +18,9 @@ bounds, the bruise cap, the design rules and the solver settings.
     multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
     model_check: spatial       # the default: baseline and optimum also run with the spatial
                                # finger (design/solve/optimize/model_check.py); none: not
+    robustness: true           # baseline and optimum also run in perturbed scenes (friction,
+                               # drum phase, other birds, stiffness, a slotted pallet:
+                               # design/solve/optimize/robustness.py); default false
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}   # beam_intervals: the
                                # finger mesh, by default the scene's contact_nodes
@@ -107,6 +110,9 @@ class DesignProblem:
     multistart: MultistartSpec = MultistartSpec()
     #: the finger model baseline and optimum are also simulated with, or ``none``
     model_check: str = CHECK_MODEL
+    #: baseline and optimum also simulated in the perturbed scenes of
+    #: design/solve/optimize/robustness.py
+    robustness: bool = False
 
     @property
     def pareto(self) -> bool:
@@ -139,8 +145,9 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     checks = (CHECK_MODEL, "none") if scene is None or scene.finger_model != CHECK_MODEL \
         else ("none",)
     model_check = reader.choice(data, "model_check", "", checks, default=checks[0])
+    robustness = reader.boolean(data, "robustness", "", default=False)
     if not reader.ok or None in (scene, variables, caps, rules, settings, multistart,
-                                 model_check) or \
+                                 model_check, robustness) or \
             ("population" in data and population is None):
         return None
     # the loop's simulations use the scene's integrator, no looser than the
@@ -157,7 +164,8 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         settings = replace(settings, nlp=replace(settings.nlp, beam_intervals=nodes),
                            contact_nodes=nodes)
     return DesignProblem(name, scene, variables, caps, rules, settings,
-                         data.get("description", ""), population, multistart, model_check)
+                         data.get("description", ""), population, multistart, model_check,
+                         robustness)
 
 
 def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:

@@ -29,7 +29,8 @@ KINDS = {
               ("finger_models", "mounts", "friction", "legs", "finger_model", "solver", "belt"),
               read_grasp),
     "design": (("scene", "variables"), ("cap", "rules", "solver", "population",
-                                             "multistart", "model_check"), read_design),
+                                         "multistart", "model_check", "robustness"),
+               read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)
 _COMMON = ("kind", "name", "description")

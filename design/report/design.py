@@ -10,6 +10,7 @@ from design.report.grasp import (animation_section, grasp_figures, reproduce_sec
 from design.report.page import Page
 from design.solve.grasp.simulation import GraspRun
 from design.solve.optimize.model_check import check_text
+from design.solve.optimize.robustness import robustness_text
 from design.solve.optimize.profile import profile_rows
 
 
@@ -148,6 +149,26 @@ def model_check_section(page: Page, check: dict) -> None:
         page.text("Validity problems of the spatial runs: " + "; ".join(check["model_warnings"]))
 
 
+def robustness_section(page: Page, robust: dict) -> None:
+    """Baseline and optimum in the perturbed scenes (design/solve/optimize/robustness.py)."""
+    page.section("Robustness: what the problem does not know", "robustness")
+    page.text(f"{robustness_text(robust)[0].upper()}{robustness_text(robust)[1:]} (target: "
+              f"{robust['target_share']:.0%}). Each scene changes one thing the design problem "
+              f"fixes; the optimum beats the baseline where it holds longer, stays under the "
+              f"{robust['cap_N']:.2f} N cap and does not jam. Both designs run on the "
+              f"optimiser's simulator.")
+    page.table([{"scene": r["case"],
+                 "baseline hold (s)": r["baseline_hold_time_s"],
+                 "optimum hold (s)": r["optimum_hold_time_s"],
+                 "baseline peak (N)": r["baseline_max_finger_force_N"],
+                 "optimum peak (N)": r["optimum_max_finger_force_N"],
+                 "baseline jam": r["baseline_jam"] or "none",
+                 "optimum jam": r["optimum_jam"] or "none",
+                 "optimum beats baseline": r["optimum_beats_baseline"]}
+                for r in robust["cases"]], "Baseline and optimum in perturbed scenes",
+               "robustness-table")
+
+
 def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     """``baseline`` and ``optimum`` are the independent (fine) simulations."""
     page = Page(f"Design: {result['name']}")
@@ -197,6 +218,8 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     grasp_figures(page, {"baseline": baseline, "optimum": optimum}, v["cap_N"])
     if result.get("model_check"):
         model_check_section(page, result["model_check"])
+    if result.get("robustness"):
+        robustness_section(page, result["robustness"])
     page.section("Optimiser convergence", "convergence")
     history = result["solver"]["history"]
     page.table([{"outer iteration": h["iteration"], "trust region": h["radius"],

@@ -34,9 +34,11 @@ from design.run.animation import animation_record
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.reproducible import numerics, one_blas_thread
+from design.solve.optimize import robustness
+from design.solve.optimize.robustness import robustness_text
 from design.solve.optimize.model_check import BASELINE, ModelCheck, check_text
-from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, SETUP, STUDY,
-                                           VERIFICATION, Profile, clocks)
+from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
+                                           SETUP, STUDY, VERIFICATION, Profile, clocks)
 from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solve.optimize.population import Member, Population
@@ -93,12 +95,15 @@ def run(problem: DesignProblem, progress: Progress | None = None,
         study: StudyOptions | None = None) -> RunOutput:
     """Optimise from every starting design for every cap (Pareto caps chained
     tightest first within a start), verify, and pick per cap the best
-    verified design; a population also gets its single-bird comparison.
+    verified design; a population also gets its single-bird comparison. The
+    spatial model check and the robustness table's runs go to a background
+    process (``check``).
     The cases run through design/study (``study``: where, and the case
     store); a study of one chain runs in this process. Every BLAS runs one
     thread (design/solve/reproducible.py): the same answer on any machine."""
-    with one_blas_thread(), ModelCheck(problem.settings.simulator) \
-            if problem.model_check != "none" else nullcontext() as check:
+    background = problem.model_check != "none" or problem.robustness
+    with one_blas_thread(), ModelCheck(problem.settings.simulator) if background \
+            else nullcontext() as check:
         return _run(problem, progress, study, check)
 
 
@@ -112,8 +117,10 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     population = population_of_problem(problem, space)
     settings = problem.settings
     d0 = space.scale(space.base_values)
-    if check:
+    if problem.model_check != "none":
         check.submit(BASELINE, population, d0)
+    if problem.robustness:
+        check.submit_setups(ROBUST_BASELINE, robustness.scenes(space.setup(d0)))
     say("simulating the baseline at 4x the optimiser's resolution"
         + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
@@ -178,15 +185,25 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
         finals[k] = _verified(population, best, results[best], settings, profile)
         entries[k].pop("d")
-    model_check = None
-    if check and entries[0]["status"] in (VERIFIED, FAILED):     # else no optimum to check
+    model_check, robust = None, None
+    optimum = entries[0]["status"] in (VERIFIED, FAILED)        # else no optimum to check
+    if problem.robustness and optimum:
+        check.submit_setups(ROBUST_OPTIMUM, robustness.scenes(space.setup(finals[0].d)))
+    if problem.model_check != "none" and optimum:
         check.submit(entries[0]["case"], population, finals[0].d)
         with profile.phase(MODEL_CHECK):
             model_check = check.result(population, problem.caps[0],
                                        optimum=entries[0]["case"])
+    if problem.robustness and optimum:
+        with profile.phase(ROBUSTNESS):
+            robust = robustness.table(check.summaries(ROBUST_BASELINE),
+                                      check.summaries(ROBUST_OPTIMUM), float(caps[0][0]))
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
                          baseline, t0, model_check)
+    if robust is not None:
+        output.result["robustness"] = robust
+        output.tables["robustness.csv"] = robust["cases"]
     if problem.population:
         comparison = population_comparison(
             space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
@@ -203,6 +220,8 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
 
 #: a case's status when its design loop ended in ERROR
 NO_DESIGN = "no design (optimiser error)"
+#: the labels of the robustness table's background runs
+ROBUST_BASELINE, ROBUST_OPTIMUM = "robustness: baseline", "robustness: optimum"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
 #: the profiles and fine simulations of the cases this process ran (the
@@ -265,7 +284,7 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     outcome = optimise(population, caps, settings, problem.rules, None if first else start,
                        progress, anchor=upstream is not None)
     certify(population, outcome, settings, problem.rules, progress)
-    if check and k == 0:
+    if check and k == 0 and problem.model_check != "none":
         check.submit(case.key, population, outcome.best.d)
     say("verifying at 4x finer resolution")
     with outcome.profile.phase(VERIFICATION):
@@ -458,6 +477,8 @@ def status_line(result: dict) -> str:
     caveat = " (by a model outside its validity)" if status == VERIFIED and \
         v["model_warnings"] else ""
     check = f"; {check_text(result['model_check'])}" if result.get("model_check") else ""
+    if result.get("robustness"):
+        check += f"; {robustness_text(result['robustness'])}"
     claimed = result["objective"]["hold_time_s"]
     claimed = "not evaluated" if claimed is None or not np.isfinite(claimed) else \
         f"{claimed:.4f} s"

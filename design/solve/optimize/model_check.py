@@ -57,7 +57,7 @@ def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
             "max_finger_force_N": s["max_finger_force_N"],
             "max_finger_force_finger": s["max_finger_force_finger"],
             "max_finger_force_time_s": float(s["max_finger_force_time_s"]),
-            "ok": s["ok"], "message": s["message"],
+            "ok": s["ok"], "message": s["message"], "jam": s["jam"],
             "model_warnings": validity_problems(s["validity"]),
             "cpu_time_s": time.process_time() - t0}
 
@@ -66,8 +66,9 @@ class ModelCheck:
     """Spatial runs of designs of a population, in a background process.
 
     ``submit(label, population, d)`` queues every bird's run of the scaled
-    design d; ``result(...)`` waits for a baseline's and an optimum's runs
-    and compares them. ``close()`` (or the ``with`` block) stops the
+    design d, ``submit_setups(label, setups)`` any scenes' (the robustness
+    table's, design/solve/optimize/robustness.py); ``result(...)`` waits
+    for a baseline's and an optimum's runs and compares them. ``close()`` (or the ``with`` block) stops the
     process, also amid a run (Ctrl-C, a failed case): a simulation still
     running there is not waited for."""
 
@@ -111,13 +112,17 @@ class ModelCheck:
 
     def submit(self, label: str, population, d: np.ndarray) -> None:
         """Queue the spatial runs of design d (scaled) for every bird, once per label."""
+        self.submit_setups(label, [m.space.setup(d) for m in population.members])
+
+    def submit_setups(self, label: str, setups: list[GraspSetup]) -> None:
+        """Queue the spatial runs of ``setups``, once per label."""
         if label in self._runs:
             return
         worker, paths = self._worker(), []
-        for m in population.members:
+        for setup in setups:
             self._count += 1
             task = Path(self._folder.name) / f"{self._count}.task"
-            task.write_bytes(pickle.dumps((m.space.setup(d), self.integrator)))
+            task.write_bytes(pickle.dumps((setup, self.integrator)))
             worker.stdin.write(f"{task}\n".encode())
             worker.stdin.flush()
             paths.append(task.with_suffix(".result"))

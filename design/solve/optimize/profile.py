@@ -67,6 +67,8 @@ RESULT = "result assembly"
 #: waiting for the spatial model check's background runs (their own CPU
 #: time is in result.json's model_check)
 MODEL_CHECK = "spatial model check (wait)"
+#: waiting for the robustness table's background runs (design/solve/optimize/robustness.py)
+ROBUSTNESS = "robustness scenes (wait)"
 #: a study's cases while they run on Dask workers (their own phases are theirs)
 STUDY = "study cases on workers"
 #: a study run in this process: what its cases spend outside their own
@@ -76,7 +78,7 @@ UNACCOUNTED = "unaccounted"
 PHASES = [SETUP, SIMULATIONS,
           *(f"{group}: {step}" for group in (OPTIMISER, VIEWS)
             for step in (CONSTRUCTION, IPOPT, READ_BACK)),
-          VERIFICATION, CASE_OVERHEAD, MODEL_CHECK, RESULT]
+          VERIFICATION, CASE_OVERHEAD, MODEL_CHECK, ROBUSTNESS, RESULT]
 #: the rootfinders' row (their time is inside nlp_g and nlp_jac_g)
 ROOTFINDERS = "contact rootfinder solves"
 

@@ -268,11 +268,14 @@ class DesignNLP:
         forces: list = []
         mu = dyn.mu
         t0 = self.setup.start_x
-        # on the belt, untouched, until t_start: the closed-form belt motion (the
-        # belt must not start slowing before then: it would roll the bird)
+        # on the belt, untouched, until t_start: the closed-form belt motion (a
+        # belt that slows must not start before then: it would roll the bird;
+        # one that keeps its speed may 'start' when it likes)
         v_a, _, travel = self._belt(sch.t_start, values)
         if isinstance(values["conveyor.start_time"], ca.MX):
-            constrain(values["conveyor.start_time"] - sch.t_start, 0.0, np.inf, "belt start")
+            slowing = self.setup.conveyor.speed - values["conveyor.final_speed"]
+            constrain((values["conveyor.start_time"] - sch.t_start) * slowing, 0.0, np.inf,
+                      "belt start")
         bird = self.setup.bird
         start_state = ca.vertcat(t0 + travel, bird.gamma, 0.0, v_a, 0.0, 0.0)
         grid = []                       # per phase: (nodes, interval h, start time)
