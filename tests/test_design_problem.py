@@ -120,3 +120,25 @@ def test_rule_5_3_counts_the_graspers_finger_sets():
 
     assert worst(Rules(bird_spacing=0.457)) >= 0
     assert worst(Rules(bird_spacing=0.457, finger_sets=1)) < -0.1
+
+
+def test_a_problem_built_in_python_runs_with_its_files_settings():
+    """The solver policy (the loop simulator no looser than the loop's
+    tolerances and no longer-stepped than the NLP's grid, the finger mesh the
+    scene's unless stated) is the solve layer's: a problem built in Python
+    from the file's parts, or read from the file's content as a dict, runs
+    with the file's settings."""
+    path = ROOT / "problems" / "hold_time.yaml"
+    from_file = design.check(path)
+    data = yaml.safe_load(path.read_text())
+    from_dict = design.check({**data, "scene": str(ROOT / "problems" / data["scene"])})
+    built = DesignProblem(from_file.name, design.check(ROOT / "problems" / data["scene"]),
+                          from_file.variables, from_file.caps, from_file.rules,
+                          {"time_step": 0.01, "max_iter": 40, "outer_iterations": 6,
+                           "trust_region": 0.15}, model_check="none", robustness=True)
+    assert built.settings == from_file.settings == from_dict.settings
+    assert built == replace(from_file, description="")
+    loop, scene = from_file.settings, from_file.scene.settings
+    assert loop.nlp.beam_intervals == loop.contact_nodes == scene.contact_nodes
+    assert loop.simulator.max_step == loop.nlp.time_step == 0.01
+    assert loop.simulator.rtol < scene.integrator.rtol

@@ -43,9 +43,10 @@ from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
 from design.solve.optimize.finger_load import STAGE_MODELS
 from design.solve.optimize.model_check import CHECK_MODEL
+from design.solve.optimize.policy import SOLVER_KEYS, loop_settings
 from design.solve.optimize.population import AGGREGATES
-from design.solve.optimize.transcription import NLPSettings, Rules
-from design.solve.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
+from design.solve.optimize.transcription import Rules
+from design.solve.optimize.trust_region import LoopSettings
 from design.solve.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
                                              GROUP_FIELDS)
 
@@ -102,7 +103,9 @@ class DesignProblem:
     variables: dict[str, tuple[float, float]]
     caps: list[Cap]
     rules: Rules
-    settings: LoopSettings
+    #: the solver options as the problem states them (SI; any of
+    #: design/solve/optimize/policy.py's SOLVER_KEYS, the rest default)
+    solver: dict
     description: str = ""
     #: several birds (robust design), or None: the scene's bird alone
     population: PopulationSpec | None = None
@@ -117,6 +120,12 @@ class DesignProblem:
     @property
     def pareto(self) -> bool:
         return len(self.caps) > 1
+
+    @property
+    def settings(self) -> LoopSettings:
+        """The settings the design loop runs with: :attr:`solver` under the
+        solve layer's policy (:func:`design.solve.optimize.policy.loop_settings`)."""
+        return loop_settings(self.solver, self.scene.settings)
 
 
 def variable_names(scene: GraspScene) -> list[str]:
@@ -133,7 +142,7 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
     variables = _variables(reader, data["variables"], scene) if "variables" in data else None
     caps = _caps(reader, data.get("cap", "baseline"))
     rules = _rules(reader, data.get("rules", {}))
-    settings = _settings(reader, data.get("solver", {}))
+    solver = _solver(reader, data.get("solver", {}))
     population = _population(reader, data["population"], base_dir) \
         if "population" in data else None
     multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
@@ -146,24 +155,11 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         else ("none",)
     model_check = reader.choice(data, "model_check", "", checks, default=checks[0])
     robustness = reader.boolean(data, "robustness", "", default=False)
-    if not reader.ok or None in (scene, variables, caps, rules, settings, multistart,
+    if not reader.ok or None in (scene, variables, caps, rules, solver, multistart,
                                  model_check, robustness) or \
             ("population" in data and population is None):
         return None
-    # the loop's simulations use the scene's integrator, no looser than the
-    # loop's own tolerances (trust_region.LOOP_SIMULATOR), with steps no longer
-    # than the NLP's time grid (whose view of a design must reproduce them; the
-    # verification runs at a quarter of it), with the NLP's finger mesh
-    given, tight = scene.settings.integrator, LOOP_SIMULATOR
-    settings = replace(settings, simulator=replace(
-        given, rtol=min(given.rtol, tight.rtol), atol=min(given.atol, tight.atol),
-        max_step=min(given.max_step, settings.nlp.time_step)))
-    solver = data.get("solver", {})
-    if "beam_intervals" not in solver:       # the finger mesh: the scene's unless given
-        nodes = scene.settings.contact_nodes
-        settings = replace(settings, nlp=replace(settings.nlp, beam_intervals=nodes),
-                           contact_nodes=nodes)
-    return DesignProblem(name, scene, variables, caps, rules, settings,
+    return DesignProblem(name, scene, variables, caps, rules, solver,
                          data.get("description", ""), population, multistart, model_check,
                          robustness)
 
@@ -330,31 +326,30 @@ def _rules(reader: Reader, value: object) -> Rules | None:
     return Rules(sigma, spacing, sets)
 
 
-def _settings(reader: Reader, value: object) -> LoopSettings | None:
-    spec = reader.mapping(value, "solver", optional=(
-        "time_step", "beam_intervals", "max_iter", "tolerance", "outer_iterations",
-        "trust_region", "cap_margin", "ipopt"))
+#: a design problem's integer solver options: [lowest, highest]
+SOLVER_INTEGERS = {"beam_intervals": (2, 32), "max_iter": (1, 10000), "outer_iterations": (0, 100)}
+#: its other numeric solver options: dimension, lowest, highest, lowest excluded
+SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
+                     "tolerance": ("dimensionless", 1e-12, 1e-2, False),
+                     "trust_region": ("dimensionless", 0.0, 1.0, True),
+                     "cap_margin": ("dimensionless", 0.0, 0.9, False)}
+
+
+def _solver(reader: Reader, value: object) -> dict | None:
+    """The solver options the problem states, validated, in SI; the solve
+    layer decides the rest (design/solve/optimize/policy.py)."""
+    spec = reader.mapping(value, "solver", optional=SOLVER_KEYS)
     if spec is None:
         return None
-    d, n = LoopSettings(), NLPSettings()
-    step = reader.quantity(spec, "time_step", "solver", "time", lo=5e-4, hi=0.05,
-                           default=n.time_step)
-    beam = reader.integer(spec, "beam_intervals", "solver", lo=2, hi=32,
-                          default=n.beam_intervals)
-    iters = reader.integer(spec, "max_iter", "solver", lo=1, hi=10000, default=n.max_iter)
-    tol = reader.quantity(spec, "tolerance", "solver", "dimensionless", lo=1e-12, hi=1e-2,
-                          default=n.tol)
-    outer = reader.integer(spec, "outer_iterations", "solver", lo=0, hi=100,
-                           default=d.outer_iterations)
-    radius = reader.quantity(spec, "trust_region", "solver", "dimensionless", lo=0.0,
-                             lo_open=True, hi=1.0, default=d.radius)
-    margin = reader.quantity(spec, "cap_margin", "solver", "dimensionless", lo=0.0, hi=0.9,
-                             default=d.cap_margin)
-    ipopt = spec.get("ipopt", {})
-    if not isinstance(ipopt, Mapping):
-        reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")
-        return None
-    if None in (step, beam, iters, tol, outer, radius, margin):
-        return None
-    nlp = NLPSettings(step, beam, n.degree, iters, tol, dict(ipopt))
-    return LoopSettings(nlp, outer, radius, d.min_radius, d.simulator, beam, margin)
+    stated = {key: reader.integer(spec, key, "solver", lo=lo, hi=hi)
+              for key, (lo, hi) in SOLVER_INTEGERS.items() if key in spec}
+    stated.update({key: reader.quantity(spec, key, "solver", dimension, lo=lo, hi=hi,
+                                        lo_open=lo_open)
+                   for key, (dimension, lo, hi, lo_open) in SOLVER_QUANTITIES.items()
+                   if key in spec})
+    if "ipopt" in spec:
+        if not isinstance(spec["ipopt"], Mapping):
+            reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")
+            return None
+        stated["ipopt"] = dict(spec["ipopt"])
+    return None if None in stated.values() else stated
