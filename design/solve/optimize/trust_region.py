@@ -66,9 +66,9 @@ BACK_OFF = 0.9
 
 #: the loop's simulator is tighter than a grasp scene's default (rtol 1e-4):
 #: its accept/reject decisions compare holds a few ms apart and its views
-#: must reproduce them within 2 % (`design tradeoff` on a design problem
-#: measures the loop at other tolerances). Its steps are no longer than the
-#: NLP's time grid (a design problem's own: design/solve/optimize/policy.py)
+#: must reproduce them within 2 % (docs/design-method.md). Its steps are no
+#: longer than the NLP's time grid (a design problem's own grid:
+#: design/solve/optimize/policy.py)
 LOOP_SIMULATOR = IntegratorSettings(rtol=1e-6, atol=1e-8, max_step=NLPSettings.time_step)
 
 
