@@ -19,7 +19,7 @@ import hashlib
 import pickle
 import time
 from contextlib import nullcontext
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from functools import partial
 
 import numpy as np
@@ -134,8 +134,9 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     if chains == 1:
         options = replace(options, workers=1, scheduler=None)
     local = options.workers == 1 and scheduler_address(options) is None
+    kept = Kept() if local else None
     task = partial(solve_case, problem, progress if local and chains == 1 else None,
-                   check if local else None)
+                   check if local else None, kept)
     # in this process the cases' own profiles and the engine's rest add up to
     # the study's time; on workers it is one phase of this process
     started = clocks()
@@ -145,26 +146,24 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
                             problem_digest=problem_digest(problem))
     study = [now - then for now, then in zip(clocks(), started)]
     before = profile.timed()
+    own = kept.profiles if kept else {}
     for key in results:
-        if key in _PROFILES:
-            profile.merge(_PROFILES.pop(key))
+        if key in own:
+            profile.merge(own[key])
     if local:
         cases_own = [now - then for now, then in zip(profile.timed(), before)]
         profile.add(CASE_OVERHEAD, max(study[0] - cases_own[0], 0.0), 1,
                     max(study[1] - cases_own[1], 0.0))
-    try:
-        output = _assemble(problem, space, population, cases, results, baseline, caps,
-                           profile, t0, check)
-    finally:
-        for key in results:             # none left for a later run's case of this key
-            _FINE.pop(key, None)
+    output = _assemble(problem, space, population, cases, results, baseline, caps,
+                       profile, t0, check, kept)
     output.result["profile"] = profile.summary()
     return output
 
 
 def _assemble(problem: DesignProblem, space: DesignSpace, population: Population,
               cases: list[Case], results: dict, baseline: Scored, caps: list[np.ndarray],
-              profile: Profile, t0: float, check: ModelCheck | None) -> RunOutput:
+              profile: Profile, t0: float, check: ModelCheck | None, kept: Kept | None
+              ) -> RunOutput:
     """The run's output from its cases' results: per cap the best verified
     case, a multistart's optima, a population's comparison, the first cap's
     design on the spatial finger model (``check``). A failed case fails the
@@ -183,7 +182,7 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
             entries[k]["status"] = ERROR
         if problem.multistart.starts > 1:
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
-        finals[k] = _verified(population, best, results[best], settings, profile)
+        finals[k] = _verified(population, best, results[best], settings, profile, kept)
         entries[k].pop("d")
     model_check, robust = None, None
     optimum = entries[0]["status"] in (VERIFIED, FAILED)        # else no optimum to check
@@ -224,10 +223,16 @@ NO_DESIGN = "no design (optimiser error)"
 ROBUST_BASELINE, ROBUST_OPTIMUM = "robustness: baseline", "robustness: optimum"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
-#: the profiles and fine simulations of the cases this process ran (the
-#: engine returns JSON; the report needs the simulations themselves)
-_PROFILES: dict[str, Profile] = {}
-_FINE: dict[str, Scored] = {}
+
+
+@dataclass
+class Kept:
+    """What the cases a run ran in its own process leave beside their JSON
+    results (the study engine returns JSON; the profile and the report need
+    the objects): each case's profile and its 4x finer simulations."""
+
+    profiles: dict[str, Profile] = field(default_factory=dict)
+    fine: dict[str, Scored] = field(default_factory=dict)
 
 
 def design_cases(problem: DesignProblem, space: DesignSpace, population: Population,
@@ -263,18 +268,19 @@ def design_bird_peak(population: Population, space: DesignSpace, baseline: Score
 
 
 def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCheck | None,
-               case: Case, upstream: dict | None) -> dict:
+               kept: Kept | None, case: Case, upstream: dict | None) -> dict:
     """One case of :func:`design_cases`: the design loop from the case's
     start (or the upstream cap's optimum), its certification and its 4x
     finer verification; the result as result.json's entry for a cap, with
     the scaled design ``d``. ``check``: where the first cap's design starts
-    its spatial runs, before its verification (this process's cases only)."""
+    its spatial runs, before its verification, and ``kept`` where it leaves
+    its profile and simulations (this process's cases only)."""
     say = progress or (lambda message: None)
     space = design_space(problem)
     population = population_of_problem(problem, space)
     settings = problem.settings
     if case.key == SINGLE_BIRD:
-        return _single_bird(problem, space, population, case)
+        return _single_bird(problem, space, population, case, kept)
     k = case.inputs["cap_index"]
     caps = np.array(case.inputs["caps_N"])
     start = np.array(upstream["d"]) if upstream else np.array(case.inputs["start"])
@@ -290,7 +296,8 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     with outcome.profile.phase(VERIFICATION):
         fine = verify(population, outcome.best.d, settings)
     entry = _entry(space, problem, outcome, fine, problem.caps[k])
-    _PROFILES[case.key], _FINE[case.key] = outcome.profile, fine
+    if kept is not None:
+        kept.profiles[case.key], kept.fine[case.key] = outcome.profile, fine
     v = entry["verification"]
     # a loop that could not work from this start is an answer, not a failed
     # case (the study engine's "error": the computation raised)
@@ -303,14 +310,15 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
 
 
 def _single_bird(problem: DesignProblem, space: DesignSpace, population: Population,
-                 case: Case) -> dict:
+                 case: Case, kept: Kept | None) -> dict:
     """The scene's own bird optimised alone at its cap, verified on every bird."""
     settings = problem.settings
     own = Population.of(space)
     cap = case.inputs["cap_N"]
     outcome = optimise(own, cap, settings, problem.rules)
     fine = verify(population, outcome.best.d, settings)
-    _PROFILES[case.key] = outcome.profile
+    if kept is not None:
+        kept.profiles[case.key] = outcome.profile
     return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
             "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
             "peaks_N": fine.peaks.tolist(), "hold_time_s": fine.hold}
@@ -323,11 +331,11 @@ def _rank(result: dict) -> tuple:
             if result["status"] == VERIFIED else 0.0)
 
 
-def _verified(population: Population, key: str, result: dict, settings, profile: Profile
-              ) -> Scored:
+def _verified(population: Population, key: str, result: dict, settings, profile: Profile,
+              kept: Kept | None) -> Scored:
     """The 4x finer simulations of a case's design: the case's own if it
     ran in this process, else simulated again (deterministic: the same)."""
-    fine = _FINE.pop(key, None)
+    fine = kept.fine.get(key) if kept else None
     if fine is None:
         with profile.phase(VERIFICATION):
             fine = verify(population, np.array(result["d"]), settings)
