@@ -92,7 +92,7 @@ def run_case(name: str, repeat: int) -> dict:
              "compiled": compiled.status.summary(libraries)}
     api_times, bvp_times, solve_times = [], [], []
     for _ in range(repeat):
-        result, wall, cpu = clocked(lambda: design.simulate(scene))
+        result, wall, cpu = clocked(lambda: design.simulate(scene).to_dict())
         api_times.append((wall, cpu))
         solve_times.append(result["solve_time_s"])
         (points, status), wall, cpu = clocked(lambda: bvp_sweep(finger, loads, BVP_TOL))

@@ -231,7 +231,7 @@ def measure_row(step: float, beam: int) -> dict:
     process's peak resident set at the end."""
     t0 = time.perf_counter()
     rss_start = rss_mib()
-    problem = check(ROOT / "problems" / "hold_time.yaml")
+    problem = check(ROOT / "problems" / "hold_time.yaml").value
     space = design_space(problem)
     d0 = space.scale(space.base_values)
     box = (np.clip(d0 - RADIUS, 0, 1), np.clip(d0 + RADIUS, 0, 1))
@@ -350,7 +350,7 @@ def main_job() -> dict:
     load = os.getloadavg()
     t0 = time.perf_counter()
     result = solve(ROOT / "problems" / "hold_time.yaml",
-                   progress=lambda message: print(f"  {message}", flush=True))
+                   progress=lambda message: print(f"  {message}", flush=True)).to_dict()
     wall = time.perf_counter() - t0
     v = result["verification"]
     print(f"\nmain job: {result['status']}; verified hold {v['hold_time_s']:.4f} s (optimiser "

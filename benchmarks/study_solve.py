@@ -71,7 +71,7 @@ def main() -> None:
         for workers in (1, 2):
             out = Path(folder) / f"workers_{workers}"
             t0, cpu = time.perf_counter(), time.process_time()
-            result = solve(path, out, workers=workers)
+            result = solve(path, out, workers=workers).to_dict()
             wall = time.perf_counter() - t0
             outcomes[workers] = cases(out)
             case_times = [row["wall_time_s"] for row in read_cases(out / STORE)]

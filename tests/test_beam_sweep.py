@@ -84,7 +84,8 @@ def test_a_sweeps_shape_table_has_every_case_and_point():
 
     finger = ROOT / "models" / "fingers" / "thesis_nonuniform_soft.yaml"
     result = design.simulate({"kind": "beam", "finger": str(finger),
-                              "load": {"F": [0, 5, 10, 15, 20], "alpha": "60 deg", "at": 0.1}})
+                              "load": {"F": [0, 5, 10, 15, 20], "alpha": "60 deg", "at": 0.1}}
+                             ).to_dict()
     rows = ShapeRows(result["cases"])
     expected = [{"case": i, "s_m": s, "x_m": x, "y_m": y, "psi_rad": p, "M_N_m": m}
                 for i, c in enumerate(result["cases"])

@@ -21,14 +21,14 @@ def test_simulate_writes_result_json_that_equals_the_api(tmp_path):
     out = tmp_path / "out"
     assert main(["simulate", str(scene), "--out", str(out), "--quiet"]) == 0
     written = json.loads((out / "result.json").read_text())
-    api = jsonable(design.simulate(scene))
+    api = jsonable(design.simulate(scene).to_dict())
     assert written.pop("solve_time_s") > 0 and api.pop("solve_time_s") > 0
     assert written == api
     case = written["cases"][0]
     for key in ["F", "alpha", "at", "tip", "shape", "error_estimate", "converged", "branch"]:
         assert key in case
     assert set(case["shape"]) >= {"s", "x", "y", "psi"}
-    assert written["kind"] == "beam"
+    assert written["kind"] == "beam" and written["status"] == "finished"
     assert case["converged"] and case["error_estimate"] < 1e-8
     rows = list(csv.DictReader((out / "cases.csv").open()))
     assert float(rows[0]["tip_y_m"]) == pytest.approx(case["tip"]["y"])
@@ -36,10 +36,14 @@ def test_simulate_writes_result_json_that_equals_the_api(tmp_path):
 
 def test_sweep_result_has_one_case_per_load(tmp_path):
     result = design.simulate(ROOT / "problems" / "beam_sweep.yaml", out=tmp_path)
-    forces = [c["F"] for c in result["cases"]]
+    cases = result.to_dict()["cases"]
+    forces = [c["F"] for c in cases]
     assert forces == [0, 2.5, 5, 7.5, 10, 12.5, 15, 17.5, 20, 22.5, 25, 27.5, 30]
-    assert result["cases"][0]["branch"] == "straight"
-    assert all(c["branch"] == "primary" for c in result["cases"][1:])
+    assert result.cases == result.converged == 13
+    assert cases[0]["branch"] == "straight"
+    assert all(c["branch"] == "primary" for c in cases[1:])
+    assert result.files[0] == tmp_path / "result.json" and all(p.is_file() for p in result.files)
+    assert json.loads(result.files[0].read_text()) == json.loads(result.to_json())
 
 
 def test_default_output_folder_is_reports_scene_name(tmp_path, monkeypatch):
@@ -57,16 +61,18 @@ def test_console_command_is_installed():
     assert done.returncode == 0 and "OK" in done.stdout
 
 
-def test_the_documented_api_is_callable_and_the_version_is_shown(capsys):
-    """README's Python calls exist as documented (`from design.api import
-    solve`, `design.simulate`, `design.check`); `design --version` prints the
+def test_the_package_is_the_api_and_the_version_is_shown(capsys):
+    """`import design` offers the five functions and the result types, and
+    loads no solver until one is called; `design --version` prints the
     package's version."""
-    import design
-    from design.api import solve
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
-    assert "from design.api import solve" in readme and "design.solve(" not in readme
-    assert callable(solve) and callable(design.simulate) and callable(design.check)
-    assert "os" not in dir(design)
+    done = subprocess.run([sys.executable, "-c", "import sys, design; "
+                           "print(sorted(design.__all__), dir(design) == sorted(design.__all__), "
+                           "'casadi' in sys.modules)"], capture_output=True, text=True,
+                          timeout=60, cwd=ROOT)
+    assert done.stdout.split("] ")[1].split() == ["True", "False"]
+    for name in ("simulate", "solve", "fit", "check", "animate", "Status", "DesignResult"):
+        assert name in done.stdout
+    assert callable(design.simulate) and callable(design.check) and callable(design.animate)
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
     assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"design {design.__version__}"
@@ -80,8 +86,8 @@ def _must_not_run(*args, **kwargs):
 def nothing_runs(monkeypatch):
     """Every command's work replaced by a failure: the folder check must come first."""
     from design.api import RUNNERS
-    from design.reproduce import command as reproduce
-    from design.tradeoff import command as tradeoff
+    from design.reproduce import report as reproduce
+    from design.tradeoff import run as tradeoff
 
     for kind in RUNNERS:
         monkeypatch.setitem(RUNNERS, kind, _must_not_run)
@@ -156,7 +162,8 @@ def test_reusing_an_output_folder_leaves_only_the_new_runs_files(tmp_path, capsy
     capsys.readouterr()
     assert main(["simulate", str(ROOT / "problems" / "contact_case1.yaml"), "--out", str(out),
                  "--quiet"]) == 0
-    written = capsys.readouterr().out.split()
+    *written, verdict = capsys.readouterr().out.splitlines()
+    assert verdict == "finished: every case converged"
     assert sorted(str(p) for p in out.rglob("*") if p.is_file()) == sorted(
         [*written, str(out / "notes.txt"), str(out / ".design-outputs")])
     assert json.loads((out / "result.json").read_text())["kind"] == "contact"
@@ -212,7 +219,7 @@ def test_a_design_reports_footer_says_design_solve():
 def test_a_scene_given_as_content_has_no_command(tmp_path):
     scene = {"kind": "beam", "finger": {"length": 0.2, "EI": 0.08},
              "load": {"F": 15, "alpha": 1.5, "at": 0.1}}
-    assert "scene_file" not in design.simulate(scene, out=tmp_path)
+    assert "scene_file" not in design.simulate(scene, out=tmp_path).to_dict()
     assert "The scene was given as content from Python, not as a file." in (
         tmp_path / "report.html").read_text()
 
@@ -223,7 +230,7 @@ def test_beam_shape_is_the_whole_finger_and_tip_is_the_load_point(tmp_path):
     import numpy as np
     import yaml
 
-    result = design.simulate(ROOT / "problems" / "beam_table_2_3.yaml", out=tmp_path)
+    result = design.simulate(ROOT / "problems" / "beam_table_2_3.yaml", out=tmp_path).to_dict()
     length, case = result["finger"]["length"], result["cases"][0]
     shape = {k: np.array(v) for k, v in case["shape"].items()}
     assert case["at"] < length and shape["s"][-1] == length
@@ -237,6 +244,7 @@ def test_beam_shape_is_the_whole_finger_and_tip_is_the_load_point(tmp_path):
     rows = list(csv.DictReader((tmp_path / "shapes.csv").open()))
     assert float(rows[-1]["s_m"]) == pytest.approx(length)
     scene = yaml.safe_load((ROOT / "problems" / "beam_table_2_3.yaml").read_text())
-    at_the_end = design.simulate({**scene, "load": {"F": 15, "alpha": "90 deg"}})["cases"][0]
+    at_the_end = design.simulate({**scene, "load": {"F": 15, "alpha": "90 deg"}}
+                                 ).to_dict()["cases"][0]
     assert at_the_end["shape"]["s"][-1] == at_the_end["at"] == length
     assert at_the_end["shape"]["x"][-1] == at_the_end["tip"]["x"]

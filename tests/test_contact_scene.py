@@ -18,7 +18,7 @@ SCENE = {"kind": "contact", "finger": {"length": 0.203, "EI": 0.08}, "drum": {"r
 
 def test_contact_scene_result_fields(tmp_path):
     result = design.simulate(SCENE, out=tmp_path)
-    case = result["cases"][0]
+    case = result.to_dict()["cases"][0]
     for key in ["contact", "force", "force_vector", "point", "point_world", "psi", "alpha",
                 "arc_length", "tip_contact", "sliding", "shape", "converged", "iterations"]:
         assert key in case
@@ -34,15 +34,15 @@ def test_pass_with_lists_and_units(tmp_path):
                         "center": [[-0.1778, 0.184], [-0.1016, 0.184], [-0.0254, 0.184]]},
              "sliding": "auto", "motion": {"drum_speed": "20 rpm", "object_velocity": [0.508, 0]}}
     result = design.simulate(scene)
-    forces = [c["force"] for c in result["cases"]]
+    forces = result.forces_N
     assert len(forces) == 3 and forces[0] < forces[1] < forces[2]
-    assert {c["friction"] for c in result["cases"]} == {"baseward"}
+    assert {c["friction"] for c in result.to_dict()["cases"]} == {"baseward"}
 
 
 def test_thesis_methods_run_from_files(tmp_path):
     for method in ["thesis-1", "thesis-2"]:
         result = design.simulate({**SCENE, "solver": {"method": method}})
-        assert result["cases"][0]["converged"] and result["method"] == method
+        assert result.converged == 1 and result.method == method
 
 
 @pytest.mark.parametrize("change, field, text", [
@@ -68,7 +68,7 @@ def test_bad_contact_input(tmp_path, capsys, change, field, text):
 
 def test_shipped_contact_problems_run(tmp_path):
     result = design.simulate(ROOT / "problems" / "contact_pass.yaml", out=tmp_path)
-    peak = max(c["force"] for c in result["cases"])
+    peak = max(result.forces_N)
     assert 29 < peak < 33
     written = json.loads((tmp_path / "result.json").read_text())
     assert written["kind"] == "contact" and len(written["cases"]) == 28

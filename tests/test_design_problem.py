@@ -9,7 +9,6 @@ import yaml
 
 import design
 from design.cli import main
-from design.errors import ProblemFileError
 from design.io.design_problem import DesignProblem
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -23,14 +22,15 @@ def problem(**change) -> dict:
 
 def test_shipped_problems_are_valid():
     for name in ("hold_time.yaml", "hold_time_tight_cap.yaml", "hold_time_pareto.yaml"):
-        p = design.check(ROOT / "problems" / name)
-        assert isinstance(p, DesignProblem) and p.variables
+        result = design.check(ROOT / "problems" / name)
+        assert result.success and result.kind == "design" and result.name == name[:-5]
+        assert isinstance(result.value, DesignProblem) and result.value.variables
 
 
 def test_units_and_caps_are_read_in_si():
     p = design.check(problem(variables={"fingers.4.angle": ["100 deg", "120 deg"],
                                         "conveyor.rate": ["50 cm/s^2", "3 m/s^2"]},
-                             cap=[{"relative_to_baseline": 0.75}, "40 N", "baseline"]))
+                             cap=[{"relative_to_baseline": 0.75}, "40 N", "baseline"])).value
     lo, hi = p.variables["fingers.4.angle"]
     assert lo == pytest.approx(100 * 3.141592653589793 / 180) and hi > lo
     assert p.variables["conveyor.rate"] == pytest.approx((0.5, 3.0))
@@ -61,10 +61,10 @@ def test_units_and_caps_are_read_in_si():
      "model_check", "'spatial' is not one of: none"),
 ])
 def test_bad_problem_is_rejected_with_file_and_field(change, field, text):
-    with pytest.raises(ProblemFileError) as err:
-        design.check(problem(**change))
-    assert any(p.field == field and text in p.message for p in err.value.problems), \
-        [str(p) for p in err.value.problems]
+    result = design.check(problem(**change))
+    assert result.status == design.Status.INVALID and result.value is None
+    assert any(p.field == field and text in p.message for p in result.problems), \
+        [str(p) for p in result.problems]
 
 
 def test_a_simulation_only_finger_model_is_refused_by_name(tmp_path):
@@ -75,9 +75,8 @@ def test_a_simulation_only_finger_model_is_refused_by_name(tmp_path):
         scene[key] = str(ROOT / scene[key])
     path = tmp_path / "scene.yaml"
     path.write_text(yaml.safe_dump({**scene, "finger_model": "planar-thesis"}))
-    with pytest.raises(ProblemFileError) as err:
-        design.check(problem(scene=str(path)))
-    assert [(p.field, "for simulations only" in p.message) for p in err.value.problems] == \
+    problems = design.check(problem(scene=str(path))).problems
+    assert [(p.field, "for simulations only" in p.message) for p in problems] == \
         [("scene.finger_model", True)]
 
 
@@ -129,10 +128,10 @@ def test_a_problem_built_in_python_runs_with_its_files_settings():
     from the file's parts, or read from the file's content as a dict, runs
     with the file's settings."""
     path = ROOT / "problems" / "hold_time.yaml"
-    from_file = design.check(path)
+    from_file = design.check(path).value
     data = yaml.safe_load(path.read_text())
-    from_dict = design.check({**data, "scene": str(ROOT / "problems" / data["scene"])})
-    built = DesignProblem(from_file.name, design.check(ROOT / "problems" / data["scene"]),
+    from_dict = design.check({**data, "scene": str(ROOT / "problems" / data["scene"])}).value
+    built = DesignProblem(from_file.name, design.check(ROOT / "problems" / data["scene"]).value,
                           from_file.variables, from_file.caps, from_file.rules,
                           {"time_step": 0.01, "max_iter": 40, "outer_iterations": 6,
                            "trust_region": 0.15}, model_check="none", robustness=True)

@@ -78,10 +78,11 @@ def test_a_constant_belt_is_fitted_as_constant(tmp_path):
     (tmp_path / "log.csv").write_text(rows)
     result = fit({"kind": "fit", "target": "belt", "data": str(tmp_path / "log.csv")},
                  out=tmp_path / "out")
-    assert not result["decelerates"]
-    assert result["fitted"]["speed"] == pytest.approx(0.457, abs=3 * NOISE / np.sqrt(t.size))
-    spec = yaml.safe_load((tmp_path / "out" / "conveyor.yaml").read_text())
-    assert "final_speed" not in spec and spec["speed"] == pytest.approx(result["fitted"]["speed"])
+    record = result.to_dict()
+    assert result.status == "fitted" and not record["decelerates"]
+    assert record["fitted"]["speed"] == pytest.approx(0.457, abs=3 * NOISE / np.sqrt(t.size))
+    spec = yaml.safe_load(result.model_file.read_text())
+    assert "final_speed" not in spec and spec["speed"] == pytest.approx(record["fitted"]["speed"])
 
 
 def test_the_monotone_fit_is_non_increasing_and_the_ramp_fit_finds_a_sharp_ramp():

@@ -11,7 +11,7 @@ import pytest
 from design.io.scene import check_file
 from design.physics.kinematics import Ellipsoid
 
-GRASPER = check_file("models/graspers/thesis_table_5_1.yaml")
+GRASPER = check_file("models/graspers/thesis_table_5_1.yaml")[1]
 OMEGA = 20 * 2 * np.pi / 60           # 20 rpm (Tables 5-3, 5-4)
 DRUM = GRASPER.drum(OMEGA)
 

@@ -18,8 +18,11 @@ SCENE = {"kind": "grasp", "grasper": "models/graspers/thesis_table_5_1.yaml",
 
 def test_grasp_scene_writes_summary_and_timeseries(tmp_path):
     result = design.simulate(SCENE, out=tmp_path)
-    assert result["kind"] == "grasp" and result["summary"]["hold_windows"] == []
-    assert result["bird"]["mass"] == 1.8 and result["conveyor"]["speed"] == pytest.approx(0.4572)
+    record = result.to_dict()
+    assert result.hold_time_s == 0.0 and record["summary"]["hold_windows"] == []
+    assert record["bird"]["mass"] == 1.8 and record["conveyor"]["speed"] == pytest.approx(0.4572)
+    assert list(result.timeseries["t_s"]) == [float(row["t_s"]) for row in
+                                              csv.DictReader((tmp_path / "timeseries.csv").open())]
     rows = list(csv.DictReader((tmp_path / "timeseries.csv").open()))
     assert {"t_s", "X_m", "Z_m", "theta_rad", "N_N", "belt_friction_N", "F4a_x_N", "P4a_x_m"} <= set(rows[0])
     assert float(rows[-1]["t_s"]) == pytest.approx(0.2)
@@ -28,7 +31,7 @@ def test_grasp_scene_writes_summary_and_timeseries(tmp_path):
 def test_finger_models_override_a_group():
     scene = {**SCENE, "finger_models": {"lower": "models/fingers/thesis_nonuniform_soft.yaml"}}
     result = design.simulate(scene)
-    lower = [f for f in result["grasper"]["fingers"] if f["group"] == "lower"]
+    lower = [f for f in result.to_dict()["grasper"]["fingers"] if f["group"] == "lower"]
     assert all(f["stiffness"]["E"] == 4.8e6 for f in lower)
 
 
@@ -66,20 +69,18 @@ def test_mounts_change_every_set_of_a_finger():
     turns 3a, 3b and 3c alike and nothing else; an angle is set a's."""
     import math
 
-    from design.errors import ProblemFileError
-    base = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"])})
+    base = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"])}).value
     changed = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
-                            "mounts": {"3": {"phi_x": "60 deg", "angle": "80 deg"}}})
+                            "mounts": {"3": {"phi_x": "60 deg", "angle": "80 deg"}}}).value
     for a, b in zip(base.grasper.fingers, changed.grasper.fingers):
         if a.design_name == "3":
             assert b.mount.phi_x == pytest.approx(math.radians(60))
             assert b.mount.angle - b.phase == pytest.approx(math.radians(80))
         else:
             assert b.mount == a.mount
-    with pytest.raises(ProblemFileError) as err:
-        design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
-                      "mounts": {"9": {"phi_x": "60 deg"}}})
-    assert any(p.field == "mounts.9" and "no finger '9'" in p.message for p in err.value.problems)
+    bad = design.check({**SCENE, "grasper": str(ROOT / SCENE["grasper"]),
+                        "mounts": {"9": {"phi_x": "60 deg"}}})
+    assert any(p.field == "mounts.9" and "no finger '9'" in p.message for p in bad.problems)
 
 
 def test_a_finished_run_closes_with_its_numbers_and_its_validity(tmp_path, capsys):
@@ -119,7 +120,7 @@ def test_a_run_over_its_wall_time_budget_stops_and_says_so(tmp_path, capsys):
     assert main(["simulate", str(path), "--out", str(tmp_path / "out"), "--quiet"]) == 1
     summary = json.loads((tmp_path / "out" / "result.json").read_text())["summary"]
     assert not summary["ok"] and "wall-time budget of 0.2 s" in summary["message"]
-    assert f"FAILED: {summary['message']}" in capsys.readouterr().err
+    assert f"FAILED: stopped early: {summary['message']}" in capsys.readouterr().err
     t_reached = float(summary["message"].split("at t = ")[1].split(" s")[0])
     assert 0.0 <= t_reached < 0.6
 

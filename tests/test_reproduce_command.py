@@ -291,7 +291,8 @@ def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path,
     """The report is still written, naming the chapter; the exit status is 1."""
     import argparse
 
-    from design.reproduce import beam_rows, command, contact_rows
+    from design.cli.reproduce import cmd_reproduce
+    from design.reproduce import beam_rows, contact_rows
     from design.reproduce.rows import CaseFailed
 
     def fail():
@@ -300,7 +301,7 @@ def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path,
     monkeypatch.setattr(beam_rows, "compute", fail)
     monkeypatch.setattr(contact_rows, "compute", fail)
     args = argparse.Namespace(out=str(tmp_path), quick=True, quiet=True)
-    assert command.cmd_reproduce(args) == 1
+    assert cmd_reproduce(args) == 1
     result = json.loads((tmp_path / "reproduction.json").read_text())
     assert len(result["failures"]) == 2 and "did not converge: fdm" in result["failures"][0]
     assert result["rows"] == [] and result["total"] == 0

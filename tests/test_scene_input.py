@@ -138,7 +138,7 @@ def test_units_in_scene_files(tmp_path):
              "load": {"F": "15 N", "alpha": "90 deg", "at": "4 in"},
              "solver": {"method": "frisch-fay"}}
     result = design.simulate(write(tmp_path, scene))
-    case = result["cases"][0]
+    case = result.to_dict()["cases"][0]
     assert case["at"] == pytest.approx(0.1016) and case["alpha"] == pytest.approx(1.5707963267948966)
     assert case["tip"]["y"] == pytest.approx(0.049184, abs=2e-5)   # EI = 0.0800016
 
@@ -151,8 +151,8 @@ def test_written_finger_keeps_every_rigidity(name):
     import numpy as np
 
     from design.io.scene_writer import finger_spec
-    finger = design.check(ROOT / "models" / "fingers" / name)
-    again = design.check({"kind": "finger", **finger_spec(finger)})
+    finger = design.check(ROOT / "models" / "fingers" / name).value
+    again = design.check({"kind": "finger", **finger_spec(finger)}).value
     s = np.linspace(0.0, finger.length, 7)
     for a, b in [(finger.stiffness, again.stiffness), (finger.stiffness_out, again.stiffness_out),
                  (finger.torsion_rigidity, again.torsion_rigidity)]:

@@ -63,11 +63,12 @@ def load_scene(source: str | Path | Mapping) -> object:
     return scene
 
 
-def check_file(source: str | Path | Mapping) -> object:
-    """Validate any input file, scene or model; returns what it describes."""
+def check_file(source: str | Path | Mapping) -> tuple[str, object]:
+    """Validate any input file, scene, problem or model: its kind and what
+    it describes; raises :class:`ProblemFileError` with every problem found."""
     reader, data, base_dir, name = _open(source)
     if isinstance(data, Mapping) and data.get("kind") == "fit":
-        return load_fit(source)
+        return "fit", load_fit(source)
     if isinstance(data, Mapping) and data.get("kind") in MODEL_KINDS:
         kind = data["kind"]
         if kind == "finger":
@@ -75,9 +76,10 @@ def check_file(source: str | Path | Mapping) -> object:
         else:
             model = MODEL_READERS[kind](reader, dict(data), "", base_dir, name)
         reader.raise_if_any()
-        return model
+        return kind, model
     reader.raise_if_any()
-    return load_scene(source)
+    scene = load_scene(source)
+    return data["kind"], scene
 
 
 def load_fit(source: str | Path | Mapping) -> object:

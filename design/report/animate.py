@@ -9,9 +9,7 @@ solved again at those states, as the report does.
 
 from __future__ import annotations
 
-import argparse
 import json
-import sys
 import tempfile
 from pathlib import Path
 
@@ -102,17 +100,3 @@ def animate(result_dir: str | Path, out: str | Path | None = None, speed: float 
         write_video(runs, record["frame_step_s"], record["cap_N"], partial, speed)
         write_atomic_bytes(path, partial.read_bytes())
     return path
-
-
-def cmd_animate(args: argparse.Namespace) -> int:
-    from design.cli import EXIT_BAD_INPUT, EXIT_OK
-
-    try:
-        path = animate(args.result_dir, args.out, args.speed,
-                       None if args.quiet else lambda m: print(f"[design] {m}",
-                                                               file=sys.stderr, flush=True))
-    except AnimateError as exc:
-        print(f"error: {exc}. Nothing was written.", file=sys.stderr)
-        return EXIT_BAD_INPUT
-    print(path)
-    return EXIT_OK

@@ -1,4 +1,5 @@
-"""Running a validated scene: each kind's runner returns a :class:`RunOutput`."""
+"""Running a validated scene: each kind's runner returns a :class:`RunOutput`,
+which the API (design/api.py) turns into a typed result (design/result.py)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,10 @@ Progress = Callable[[str], None]
 
 @dataclass
 class RunOutput:
-    """What a run produced: the result dict (written as result.json) and CSV tables."""
+    """What a run produced: its record and CSV tables.
+
+    ``result`` is the runner's record; the typed result's ``to_dict()``
+    (design/result.py) adds its status and message, and result.json holds that."""
 
     result: dict
     tables: dict[str, list[dict]] = field(default_factory=dict)

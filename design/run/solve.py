@@ -31,6 +31,7 @@ from design.io.grasp_scene import GraspSettings
 from design.io.scene_writer import grasp_spec, scene_yaml
 from design.run import Progress, RunOutput
 from design.run.animation import animation_record
+from design.result import Status
 from design.run.grasp import setup_of, timeseries
 from design.solve.grasp.simulation import simulate_grasp
 from design.solve.reproducible import numerics, one_blas_thread
@@ -57,8 +58,8 @@ from design.study.progress import StudyProgress
 #: a scaled variable this close to 0 or 1 sits on its bound
 ACTIVE = 1e-3
 #: how a run ends; the first two are a success (exit status 0)
-VERIFIED, NO_IMPROVEMENT = "verified", "no improvement found"
-FAILED, ERROR = "failed verification", "error"
+VERIFIED, NO_IMPROVEMENT = Status.VERIFIED, Status.NO_IMPROVEMENT
+FAILED, ERROR = Status.FAILED_VERIFICATION, Status.ERROR
 
 
 def design_space(problem: DesignProblem, progress: Progress | None = None) -> DesignSpace:

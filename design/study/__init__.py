@@ -5,7 +5,7 @@ finished case kept in an SQLite case store so a stopped study resumes.
 :class:`Case` and :class:`StudyOptions` (cases.py) describe the study,
 :func:`run_study` (engine.py) runs it, :class:`StudyProgress`
 (progress.py) shows it; store.py holds the case store, cluster.py the
-Dask cluster, command.py the ``design cases`` command.
+Dask cluster (``design cases`` lists a store: design/cli/cases.py).
 """
 
 from design.study.cases import Case, StudyOptions

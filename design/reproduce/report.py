@@ -1,15 +1,10 @@
-"""``design reproduce``: rerun the thesis's reference cases and write the
-reproduction report (reproduction.json, reproduction.csv, report.html and
-figures/*.png), every row a thesis number or claim against ours.
-
-Exit status: 0 every case computed; 1 a case could not be computed (the
-report is still written, saying which); 2 the output folder cannot be
-written (checked before the first case runs).
+"""The reproduction report (``design reproduce``): the thesis's reference
+cases rerun and written as reproduction.json, reproduction.csv, report.html
+and figures/*.png, every row a thesis number or claim against ours.
 """
 
 from __future__ import annotations
 
-import argparse
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -105,21 +100,16 @@ def build_page(sections: list[Section], failures: list[str], quick: bool,
     return page, wall
 
 
-def cmd_reproduce(args: argparse.Namespace) -> int:
-    """Run the reference cases, write the report; print the paths written."""
-    from design.cli import EXIT_BAD_INPUT, EXIT_FAILED, EXIT_OK, _progress, output_folder
-
+def reproduce(out: Path, quick: bool, progress=None) -> tuple[list[Path], str, bool]:
+    """Run the reference cases and write the report to ``out``: the paths
+    written, the verdict line, and whether every chapter was computed."""
     t0 = time.perf_counter()
-    progress = None if args.quiet else _progress
-    out = output_folder(args.out, Path("reports") / "reproduction")
-    if out is None:
-        return EXIT_BAD_INPUT
-    sections, failures = compute_sections(args.quick, progress)
+    sections, failures = compute_sections(quick, progress)
     rows = [r for s in sections for r in s.rows]
     agree, total = tally(rows)
-    page, wall = build_page(sections, failures, args.quick, t0)
+    page, wall = build_page(sections, failures, quick, t0)
     result = {"kind": "reproduction", "toolkit_version": __version__, "wall_time_s": wall,
-              "quick": args.quick, "skipped": [grasp_rows.TITLE] if args.quick else [],
+              "quick": quick, "skipped": [grasp_rows.TITLE] if quick else [],
               "failures": failures, "agree": agree, "total": total,
               "by_basis": {b: {"agree": k, "total": n}
                            for b, (k, n) in tally_by_basis(rows).items()},
@@ -129,7 +119,6 @@ def cmd_reproduce(args: argparse.Namespace) -> int:
              "reproduction.csv": csv_text([r.as_dict() for r in rows])}
     if progress:
         progress(f"writing {out}")
-    for path in write_report(out, page, files):
-        print(path)
-    print(verdict(rows) + (f"; could not compute: {'; '.join(failures)}" if failures else ""))
-    return EXIT_FAILED if failures else EXIT_OK
+    written = write_report(out, page, files)
+    return written, verdict(rows) + (f"; could not compute: {'; '.join(failures)}"
+                                     if failures else ""), not failures

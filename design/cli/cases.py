@@ -11,7 +11,7 @@ import json
 import sys
 from pathlib import Path
 
-from design.cli import EXIT_BAD_INPUT, EXIT_OK, _report_problems, default_folder
+from design.cli.common import EXIT_BAD_INPUT, EXIT_OK, default_folder, report_problems
 from design.errors import ProblemFileError, StudyError
 from design.study.progress import case_table, console
 from design.study.store import STORE, read_cases
@@ -32,7 +32,7 @@ def cmd_cases(args: argparse.Namespace) -> int:
         try:
             path = default_folder(load_scene(args.source), args.source) / STORE
         except ProblemFileError as exc:
-            return _report_problems(exc)
+            return report_problems(exc)
     if not path.is_file():
         print(f"error: no case store at {path}: 'design solve' writes it there as the "
               f"problem's cases finish (--out names another output folder)", file=sys.stderr)
