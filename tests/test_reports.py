@@ -108,6 +108,9 @@ def test_beam_report(tmp_path):
     tip_y = r.column("cases-table", "tip y (m)")
     assert len(tip_y) == len(result["cases"])
     assert all(close(c, case["tip"]["y"], 6) for c, case in zip(tip_y, result["cases"]))
+    # angles in degrees, as the scene gives them (result.json keeps radians)
+    assert r.column("cases-table", "α (°)") == ["90"] and result["cases"][0]["alpha"] == \
+        pytest.approx(np.pi / 2)
 
 
 def test_contact_report(tmp_path):
@@ -118,6 +121,9 @@ def test_contact_report(tmp_path):
     forces = r.column("cases-table", "force (N)")
     assert all(close(c, case["force"]) for c, case in zip(forces, result["cases"]))
     assert r.banner.startswith(f"All {len(result['cases'])} poses converged")
+    angles = r.column("cases-table", "finger angle (°)")
+    assert all(close(c, np.degrees(case["finger_angle"])) for c, case in zip(angles,
+                                                                             result["cases"]))
 
 
 GRASP_SECTIONS = ["layout", "path", "normal-force", "finger-forces", "contact-loci"]
@@ -148,6 +154,11 @@ def test_grasp_report(tmp_path):
     assert close(rows["longest N = 0 hold"], s["hold_time_s"])
     assert close(rows["peak finger force"], s["max_finger_force_N"])
     assert rows["finger with the peak"] == s["max_finger_force_finger"]
+    assert close(rows["largest pitch"], np.degrees(s["max_pitch_rad"]))
+    fingers = r.tables["table-0"]
+    angle = fingers[0].index("angle")
+    assert [close(row[angle], np.degrees(f["angle"])) for row, f in
+            zip(fingers[1:], result["grasper"]["fingers"])] == [True] * (len(fingers) - 1)
 
 
 #: the prefetch key of :func:`solve_short_design`
@@ -217,7 +228,8 @@ def test_design_report_has_every_section_and_matches_result(design_run):
     for column, key in [("lower", "lower"), ("upper", "upper"), ("baseline", "baseline"),
                         ("optimum", "optimum")]:
         cells = r.column("variables-table", column)
-        assert all(close(c, v[key]) for c, v in zip(cells, result["variables"]))
+        assert all(close(c, v[key] * (180 / np.pi if v["unit"] == "rad" else 1.0))
+                   for c, v in zip(cells, result["variables"]))
     v = result["verification"]
     checks = r.column("verification-table", "independent simulation")
     assert close(checks[0], v["hold_time_s"]) and close(checks[1], v["max_finger_force_N"])
@@ -291,3 +303,25 @@ def test_finger_curves_draw_a_spatial_rod_whole():
     length = np.sum(np.linalg.norm(np.diff(curves[0], axis=1), axis=0))
     assert length == pytest.approx(gf.finger.length, rel=0.01)
     assert curves[1].shape[1] == 2          # no contact: the straight finger's two ends
+
+
+def test_design_variables_are_shown_in_degrees():
+    """A finger angle's bounds, baseline, optimum and change are shown in
+    degrees, as the problem file gives them; a stiffness scale as it is."""
+    from design.report.design import shown_design, variable_rows
+
+    angle = {"name": "fingers.4.angle", "unit": "rad", "lower": np.radians(100.5),
+             "upper": np.radians(124.5), "baseline": np.radians(112.5),
+             "optimum": np.radians(113.0), "active_bound": ""}
+    scale = {**angle, "name": "groups.lower.stiffness_scale", "unit": "", "lower": 0.5,
+             "upper": 2.0, "baseline": 1.0, "optimum": 2.0, "active_bound": "upper"}
+    rows = variable_rows([angle, scale])
+    assert rows[0] == {"variable": "fingers.4.angle", "unit": "deg",
+                       "lower": pytest.approx(100.5), "upper": pytest.approx(124.5),
+                       "baseline": pytest.approx(112.5), "optimum": pytest.approx(113.0),
+                       "change": pytest.approx(0.5), "active bound": ""}
+    assert rows[1]["unit"] == "" and rows[1]["optimum"] == 2.0 and rows[1]["change"] == 1.0
+    starts = shown_design({"start": 0, "fingers.4.angle": np.pi / 2,
+                           "groups.lower.stiffness_scale": 1.5, "conveyor.start_time": 0.2})
+    assert starts == {"start": 0, "fingers.4.angle (deg)": pytest.approx(90.0),
+                      "groups.lower.stiffness_scale": 1.5, "conveyor.start_time (s)": 0.2}

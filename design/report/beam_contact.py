@@ -7,6 +7,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Ellipse as EllipsePatch
 
 from design.report.grasp import reproduce_section
+from design.report.display import degrees
 from design.report.page import Page
 
 MM = 1e3
@@ -30,11 +31,12 @@ def beam_page(result: dict) -> Page:
     _verdict(page, cases, "loads")
     page.section("Finger and loads", "scene")
     page.text(f"Finger {result['finger']}; method {result['method']}.")
-    page.table([{"F (N)": c["F"], "α (rad)": c["alpha"], "at (m)": c["at"],
+    page.table([{"F (N)": c["F"], "α (°)": degrees(c["alpha"]), "at (m)": c["at"],
                  "tip x (m)": c["tip"]["x"], "tip y (m)": c["tip"]["y"],
-                 "tip ψ (rad)": c["tip"]["psi"], "error estimate (m)": c["error_estimate"],
+                 "tip ψ (°)": degrees(c["tip"]["psi"]), "error estimate (m)": c["error_estimate"],
                  "branch": c["branch"], "converged": c["converged"]}
-                for c in cases[:200]], "Loads and load-point results (SI; the first 200)",
+                for c in cases[:200]], "Loads and load-point results (angles in degrees, the rest SI; "
+               "the first 200)",
                "cases-table", digits=6)
     page.section("Deflection", "deflection")
     fig = Figure(figsize=(12, 4.4))
@@ -79,13 +81,16 @@ def contact_page(result: dict) -> Page:
     page.text(f"Finger {result['finger']}; drum radius {result['drum_radius']} m; object "
               f"semi-axes {result['object']['semi_axes']} m; friction {result['friction']}; "
               f"method {result['method']}.")
-    page.table([{"finger angle (rad)": c["finger_angle"], "object X (m)": c["object_center"][0],
+    page.table([{"finger angle (°)": degrees(c["finger_angle"]),
+                 "object X (m)": c["object_center"][0],
                  "object Y (m)": c["object_center"][1], "contact": c["contact"],
                  "force (N)": c["force"],
                  "point x_f (m)": c["point"][0] if c["point"] else None,
                  "point y_f (m)": c["point"][1] if c["point"] else None,
-                 "ψ0 (rad)": c["psi"], "friction": c["friction"], "converged": c["converged"]}
-                for c in cases], "Contact at every pose (finger frame, SI)", "cases-table")
+                 "ψ0 (°)": degrees(c["psi"]), "friction": c["friction"],
+                 "converged": c["converged"]}
+                for c in cases], "Contact at every pose (finger frame; angles in degrees, the rest "
+               "SI)", "cases-table")
     page.section("Contact force and finger shapes", "forces")
     fig = Figure(figsize=(12, 4.6))
     force, shapes = fig.subplots(1, 2)

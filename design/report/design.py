@@ -7,11 +7,13 @@ from matplotlib.figure import Figure
 
 from design.report.grasp import (animation_section, grasp_figures, reproduce_section,
                                  summary_rows)
+from design.report.display import shown
 from design.report.page import Page
 from design.solve.grasp.simulation import GraspRun
 from design.solve.optimize.model_check import check_text
 from design.solve.optimize.robustness import robustness_text
 from design.solve.optimize.profile import profile_rows
+from design.solve.optimize.variables import units
 
 
 def verification_rows(result: dict) -> list[dict]:
@@ -119,10 +121,25 @@ def multistart_section(page: Page, multistart: dict) -> None:
                  else ""))
     page.table([{"optimum": i + 1, "verified hold (s)": o["verified_hold_time_s"],
                  "verified peak (N)": o["verified_max_finger_force_N"],
-                 "starts": ", ".join(map(str, o["starts"])), **o["design"]}
+                 "starts": ", ".join(map(str, o["starts"])), **shown_design(o["design"])}
                 for i, o in enumerate(multistart["optima"])],
-               "Distinct verified optima, best first", "optima-table")
-    page.table(multistart["starts"], "Every start", "starts-table")
+               "Distinct verified optima, best first (angles in degrees)", "optima-table")
+    page.table([shown_design(row) for row in multistart["starts"]],
+               "Every start (angles in degrees)", "starts-table")
+
+
+def shown_design(row: dict) -> dict:
+    """A row holding a design's values by variable name, each in the unit a
+    report shows (angles in degrees), the unit named; the other keys as they are."""
+    out = {}
+    for key, value in row.items():
+        try:
+            unit, k = shown(units(key))
+        except KeyError:                       # not a variable
+            out[key] = value
+            continue
+        out[key if unit == "1" else f"{key} ({unit})"] = k * value
+    return out
 
 
 def model_check_section(page: Page, check: dict) -> None:
@@ -169,6 +186,19 @@ def robustness_section(page: Page, robust: dict) -> None:
                "robustness-table")
 
 
+def variable_rows(variables: list[dict]) -> list[dict]:
+    """The variables table: bounds, baseline, optimum and change, angles in
+    degrees (result.json keeps radians)."""
+    rows = []
+    for r in variables:
+        unit, k = shown(r["unit"])
+        rows.append({"variable": r["name"], "unit": unit,
+                     **{key: k * r[key] for key in ("lower", "upper", "baseline", "optimum")},
+                     "change": k * (r["optimum"] - r["baseline"]),
+                     "active bound": r["active_bound"]})
+    return rows
+
+
 def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     """``baseline`` and ``optimum`` are the independent (fine) simulations."""
     page = Page(f"Design: {result['name']}")
@@ -200,10 +230,8 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
               f"({result['cap']['given_as']}) at any instant. Caps: "
               f"{', '.join(result['problem']['caps'])}. Variables not listed keep the baseline's "
               f"value.")
-    page.table([{"variable": r["name"], "unit": r["unit"], "lower": r["lower"],
-                 "upper": r["upper"], "baseline": r["baseline"], "optimum": r["optimum"],
-                 "change": r["optimum"] - r["baseline"], "active bound": r["active_bound"]}
-                for r in result["variables"]], "Decision variables (SI)", "variables-table")
+    page.table(variable_rows(result["variables"]), "Decision variables (angles in degrees, "
+               "the rest SI)", "variables-table")
     if result["rules_broken"]:
         page.text("Design rules broken: " + "; ".join(result["rules_broken"]))
     page.section("Verification", "verification")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from design.report import grasp_figures as gf
+from design.report.display import degrees, shown
 from design.report.page import Page
 from design.report.animation import ARROW_MM_PER_N
 from design.solve.grasp.simulation import GraspRun
@@ -21,7 +22,7 @@ def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
             ("centre rise (from its start)", s["centre_rise_m"], "m"),
             ("lowest point above the belt", s["belt_clearance_m"], "m"),
             ("least belt normal force", s["min_normal_force_N"], "N"),
-            ("largest pitch", abs(s["max_pitch_rad"]), "rad")]
+            ("largest pitch", degrees(abs(s["max_pitch_rad"])), "deg")]
     if s["local_error_estimate"] is not None:
         rows.append(("largest estimated local error of a BDF-4 step (position)",
                      s["local_error_estimate"]["position_m"], "m"))
@@ -101,14 +102,16 @@ def grasp_page(result: dict, run: GraspRun) -> Page:
     b = result["bird"]
     page.text(f"Bird {b.get('name', '')}: semi-axes {np.round(np.array(b['semi_axes']), 4)} m, "
               f"mass {b.get('mass')} kg, starting at X = {result['start_X']:.3f} m on the belt; "
-              f"drums at {result['drum_speed']:.3f} rad/s, {result['grasper']['spacing']:.3f} m "
+              f"drums at {result['drum_speed'] * shown('rad/s')[1]:.2f} rpm, "
+              f"{result['grasper']['spacing']:.3f} m "
               f"apart; finger friction {result['friction']['finger']}, belt friction "
               f"{result['friction']['conveyor']}.")
-    page.table([{k: f[k] for k in ("name", "group", "length", "height", "angle", "drum_radius",
-                                   "phi_x", "phi_y")} for f in result["grasper"]["fingers"]],
-               "Fingers of the right drum (m, rad)")
+    page.table([{**{k: f[k] for k in ("name", "group", "length", "height", "drum_radius")},
+                 **{k: degrees(f[k]) for k in ("angle", "phi_x", "phi_y")}}
+                for f in result["grasper"]["fingers"]], "Fingers of the right drum (lengths in m, "
+               "angles in degrees)")
     page.section("Summary", "summary")
-    page.table(summary_rows(run), "Run summary (SI)", "summary-table")
+    page.table(summary_rows(run), "Run summary (units as given)", "summary-table")
     animation_section(page, result)
     grasp_figures(page, {"": run})
     reproduce_section(page, result,
