@@ -24,11 +24,11 @@ stated rule,
   σ-scaled residuals of m measurements (of the constrained solution) and
   H = A (AᵀA + λ DᵀD)⁻¹ Aᵀ the influence matrix of the unconstrained
   problem. Counting the constraints active at a solution as equalities (the
-  active-set influence matrix) was tried and rejected: with a monotone
+  active-set influence matrix) does not work: with a monotone
   profile it credits every flat stretch the constraints clip as saved
   degrees of freedom, and GCV then picks weights 10⁴ times smaller whose
-  wiggles only the constraints hold (measured on the thesis finger, EI
-  errors 50-90 % against 7 %);
+  wiggles only the constraints hold (EI errors several times larger on the
+  thesis finger);
 * ``l-curve``: the corner of (log ‖r‖, log ‖D c‖), the point of largest
   curvature (Hansen 1992).
 

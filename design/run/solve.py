@@ -396,8 +396,8 @@ def better_known(comparison: dict) -> str | None:
     resolution with every bird under its cap, holds the population longer
     than the robust answer: a sentence that says so. The robust answer
     stands: a design is certified only where the population's NLP
-    reproduces it (measured: the robust loop started from this design on
-    hold_time_population.yaml, and its fixed-design NLP did not converge)."""
+    reproduces it, and started from this design the robust loop's
+    fixed-design NLP need not converge."""
     hold, within = comparison["hold_time_s"], comparison["within_caps"]
     single, robust = hold["single_bird_optimum"], hold["robust_optimum"]
     if not within["single_bird_optimum"] or single <= robust:

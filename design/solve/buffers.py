@@ -1,11 +1,11 @@
 """Evaluating a CasADi function on numpy arrays through its buffer interface.
 
 ``Function.__call__`` converts each numpy input to a DM and each output back
-to numpy element by element; for a 1000-load sweep's arrays (160 x 1000
-unknowns, 81 x 1000 shape points) that took longer than the compiled
-evaluation itself (measured: 30 ms against 4 ms), and for an integrator's
-trial contact solve (63 unknowns) it was half the call (82 against 44 us).
-``Function.buffer`` reads and writes caller-owned memory instead.
+to numpy element by element; for a 1000-load sweep's arrays that takes
+longer than the compiled evaluation itself, and for an integrator's trial
+contact solve it is half the call (``python -m benchmarks.beam_sweep`` and
+``benchmarks.grasp`` time both paths' users). ``Function.buffer`` reads and
+writes caller-owned memory instead.
 """
 
 from __future__ import annotations

@@ -133,9 +133,9 @@ class NewtonCache:
 
 def implicit_rate(jz: np.ndarray, rhs: np.ndarray) -> np.ndarray:
     """The rates ż of a root of R(z, q) = 0 from jz ż = rhs (the implicit-function
-    theorem, rhs = -∂R/∂q q̇): LU, ten times faster than least squares on
-    the contact's 63 unknowns (0.03 against 0.35 ms); where jz is singular
-    (a fold), the least-squares minimum-norm rates."""
+    theorem, rhs = -∂R/∂q q̇): LU, an order of magnitude faster than least
+    squares at a contact's size; where jz is singular (a fold), the
+    least-squares minimum-norm rates."""
     try:
         return np.linalg.solve(jz, rhs)
     except np.linalg.LinAlgError:

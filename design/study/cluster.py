@@ -10,11 +10,10 @@ is recorded as an error (a running scheduler applies its own setting,
 Dask's default also 3). Dask's log lines below errors are silenced while
 the study runs.
 
-Start and stop cost on the 2-core machine, measured by ``python -m
-benchmarks.study`` at load 1.7-2.1 (five times each): two workers start in
-1.27 s (median; 1.11-1.36) and stop in 0.38 s (0.27-0.48); a study of 8
-cases of 5 ms each takes 1.49 s on them against 0.04 s in the process.
-A worker loads the solvers with its first case of a design problem.
+A LocalCluster takes about a second to start and stop, and a worker loads
+the solvers with its first case of a design problem: a study gains from
+workers when its cases take seconds (``python -m benchmarks.study``
+measures the overhead; docs/performance.md).
 
 Worker processes compiling the same CasADi function at the same time is
 safe: each builds in its own temporary folder and moves the library into

@@ -230,8 +230,8 @@ class BeamTranscription:
                    line_search: bool = True) -> ca.Function:
         """CasADi Newton rootfinder (w0, P) -> w, differentiable in P (cached).
 
-        Dense QR for the Newton steps: 20% faster than CSparse at these sizes
-        (measured, 160 unknowns).
+        Dense QR for the Newton steps: faster than CSparse at these sizes
+        (a few hundred unknowns, ``python -m benchmarks.beam``).
         """
         key = (tolerance, max_iter, line_search)
         if key not in self._cache:
@@ -284,7 +284,7 @@ def transcription(stiffness: Stiffness, intervals: int, degree: int = 4,
                   segment: bool = False) -> BeamTranscription:
     """Shared :class:`BeamTranscription` for this stiffness structure and mesh.
 
-    Building one costs 10-100 ms; fingers that differ only in their
+    Building one costs far more than a solve; fingers that differ only in their
     parameters (E, EI, the exponential's coefficients) share it.
     """
     key = (stiffness.symbolic_key(), int(intervals), int(degree), bool(segment))
@@ -305,7 +305,7 @@ class Collocation(IterativeMethod):
         if degree is not None:
             self.degree = int(degree)
         # nodal order is 2d, but fast-varying EI keeps meshes pre-asymptotic
-        # (measured orders 5-6 at K = 16 on the thesis finger): error estimates
+        # (below 2d at the default mesh on the thesis finger): error estimates
         # use the stage order d, which over-estimates by ≤ 2^d when asymptotic
         self.order = self.degree
         stiff = finger.stiffness

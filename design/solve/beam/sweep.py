@@ -9,8 +9,8 @@ run them compiled (design/solve/compiled.py, :func:`worth_compiling`), with
 condensed Newton steps (:attr:`BeamTranscription.newton_step`); others run
 interpreted, with a sparse QR factorisation of the whole Jacobian instead,
 which CasADi's virtual machine runs faster than the condensed step's many
-scalar operations (40 against 60 µs at 16 intervals, 151 against 233 at 64,
-measured; compiled, the condensed step takes 9 µs).
+scalar operations; compiled, the condensed step is the fastest
+(``python -m benchmarks.beam_sweep``).
 """
 
 from __future__ import annotations
@@ -25,18 +25,17 @@ from design.solve.compiled import compiled, compiler
 if TYPE_CHECKING:
     from design.solve.beam.collocation import BeamTranscription
 
-#: Newton steps a chained solve takes at most (a rootfinder's default; one
-#: on a 1000-load sweep, two to four on a 13-load one, measured)
+#: Newton steps a chained solve takes at most (a rootfinder's default; a
+#: dense sweep needs one, a coarse one a few)
 MAX_STEPS = 50
 #: sweeps of at least this many loads use compiled functions: building them
 #: takes seconds (once per machine: the libraries are cached), a smaller
 #: sweep milliseconds interpreted
 COMPILE_MIN_LOADS = 100
 #: ... on meshes of at most this many unknowns (16 intervals of degree 4, the
-#: default): the compiler's time grows faster than the mesh (measured: 3 s
-#: for the 8-interval library, 6.5 s for 16, 18 s for 32), and at 32
-#: intervals it saves 0.18 s per 1000 loads (0.07 s compiled, 0.25 s
-#: interpreted)
+#: default): the compiler's time grows faster than the mesh, and on a
+#: finer one it saves a fraction of a second per 1000 loads
+#: (``python -m benchmarks.beam``)
 COMPILE_MAX_UNKNOWNS = 160
 
 
@@ -53,7 +52,7 @@ class SweepFunctions:
     their forces (:meth:`start`: a run's first), the start is their quadratic
     extrapolation in F (linear, or the last solution, while the run has
     fewer distinct forces): one Newton step on a 1000-load sweep where the
-    secant predictor took two for half the loads at 60° (measured). Plain
+    secant predictor took two for half the loads at 60°. Plain
     Newton steps (no line search; condensed when compiled, by sparse QR
     otherwise) follow until max |G| ≤ ``tolerance`` or :data:`MAX_STEPS` of
     them: the start is close, and a solve that fails anyway is redone by the

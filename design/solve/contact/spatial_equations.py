@@ -122,10 +122,8 @@ class SpatialContactTranscription:
             [ca.densify(m) for m in (ca.jacobian(R, z), ca.jacobian(R, q[QUADRIC]),
                                      ca.jacobian(ca.vertcat(r, L), z))])
         # dense LU: the load's direction follows the normal at r(L), which
-        # depends on every node's quaternion, so the Jacobian is 39 % full
-        # (17 635 of 212² entries, 6 intervals of degree 4); LAPACK's LU
-        # factors it in 1.9 ms against csparse's 10 ms, and a football run to
-        # 0.6 s took 47 s against 111 s with the same answer (1e-8 relative)
+        # depends on every node's quaternion, so the Jacobian is over a third
+        # full, where LAPACK's dense LU beats a sparse factorisation
         self._newton = NewtonCache(
             f"spatial_{mode}_newton", self.residual, "lapacklu",
             lambda: compiled_jacobian(self.residual, f"{self.residual.name()}_jac_z"))
@@ -139,10 +137,10 @@ class SpatialContactTranscription:
                    error_on_fail: bool = False, compiled_jacobian: bool = False
                    ) -> ca.Function:
         """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solve.newton).
-        ``compiled_jacobian``: its Jacobian compiled, 0.26 -> 0.08 ms per
-        evaluation at 3 intervals, after 22 s of gcc per mode once (an empty
-        cache): for the optimiser's hundreds of thousands of solves, not
-        for a simulation's thousands."""
+        ``compiled_jacobian``: its Jacobian compiled, faster per evaluation
+        after seconds of gcc per mode once (an empty cache): for the
+        optimiser's hundreds of thousands of solves, not for a simulation's
+        thousands (``python -m benchmarks.solve`` profiles both)."""
         return self._newton.get(tolerance, max_iter, error_on_fail, compiled_jacobian)
 
 

@@ -59,7 +59,8 @@ from design.solve.contact.spatial_belt import SpatialBeltContact
 RATE_STEP = 1e-6
 #: a finger's friction reverses only when it slides the other way faster than
 #: this (m/s): flipping it at every sign change of the sliding speed, decided
-#: at accepted steps, chatters (measured: 50-80 N force jumps every 1-5 ms)
+#: at accepted steps, chatters (the force jumps by tens of newtons every few
+#: milliseconds)
 REVERSAL_SPEED = 0.02
 #: the spatial finger's Coulomb friction is regularised below this sliding
 #: speed (m/s): F_t = -µ N v / sqrt(|v|² + ε²); the drum sweeps the fingers
@@ -312,11 +313,10 @@ class SpatialFinger:
     to the bird's surface, at the contact point solved together with the
     force (:class:`FrictionLaw`); the finger's own deflection rate is left
     out. So the friction is a smooth function of the bird's state and time
-    alone. (Taking the contact point from the previous solution instead made
-    the loads jump at every accepted step, by 0.03 m/s² in a 0.05 m/s²
-    football acceleration measured at t = 0.99 s: the drum turns the finger's
-    velocity by 2.1 rad/s times the point's shift, and ε = 0.02 m/s amplifies
-    that; the adaptive integrator then took 1e-4 s steps.)
+    alone. (Taking the contact point from the previous solution instead makes
+    the loads jump at every accepted step: the drum turns the finger's
+    velocity by its angular speed times the point's shift, ε amplifies that,
+    and the adaptive integrator's steps collapse.)
     :meth:`SpatialContact.sliding_velocity` gives the full material velocity
     for comparison.
     """

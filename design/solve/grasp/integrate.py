@@ -11,9 +11,8 @@ reversing (its sliding against its friction passing the reversal speed).
 Finger contacts are evaluated at every stage with the friction of the last
 accepted instant; each accepted instant settles it, and the stepper restarts
 when one turns. Located as an event, a reversal comes where the sliding
-says, not up to a step late: that made the default run's hold and peak
-force depend on where the steps fell (0.35 % and 1.96 % from a 4x finer
-run on the hard-finger mean bird, 0.04 % and 0.02 % now). A finger's force
+says, not up to a step late, so the hold and peak force do not depend on
+where the steps fell (``python -m benchmarks.grasp``). A finger's force
 maxima between accepted instants are located on the dense output
 (design/solve/grasp/peaks.py), so that the peak force does not depend on
 the step either.
@@ -53,17 +52,15 @@ class IntegratorSettings:
     that takes longer, as not ok, saying where it got to."""
 
     integrator: str = "adaptive"
-    #: rtol 1e-4 / atol 1e-6 m: measured by ``design tradeoff
-    #: problems/grasp_mean_bird_hard.yaml``, 1e-6 / 1e-8 cost 48 % more for a
-    #: worst error (hold, peak force) of 0.18 % against 0.11 %
+    #: rtol 1e-4 / atol 1e-6 m: on the Pareto front of cost against hold and
+    #: peak error, where tighter tolerances cost more for no better worst
+    #: error (``design tradeoff`` on a grasp scene, ``python -m benchmarks.grasp``)
     rtol: float = 1e-4
     atol: float = 1e-6
-    #: 10 ms, with the force maxima located between steps: measured by
-    #: ``python -m benchmarks.grasp`` (hard lower fingers, planar), 0.59 s wall
-    #: per simulated second against 0.86 s at 5 ms, errors against the 4x finer
-    #: run +0.003 % / +0.02 % (hold / peak) against +0.04 % / +0.05 %; checked,
-    #: not decided, on four other scenes (README, "Grasp scenes": at most
-    #: 0.27 %). At 20 ms the trajectory departs (hold +0.36 %, peak -1.2 %).
+    #: 10 ms, with the force maxima located between steps (peaks.py): the
+    #: cheapest limit that keeps the hold and peak within the accuracy targets;
+    #: at 20 ms the trajectory itself departs (``python -m benchmarks.grasp``,
+    #: docs/performance.md)
     max_step: float = 1e-2
     stepper: str = "rk45"
     step: float = 5.6e-3
@@ -71,14 +68,9 @@ class IntegratorSettings:
     #: ``bdf4`` has no error control: a step whose estimated local error in
     #: the bird's position (m) exceeds this ends the run, not ok (math.inf:
     #: the thesis's method as it ran, unchecked). 1 mm in one step is a tenth
-    #: of the 10-20 mm lifts the thesis reports. Decided on the benchmark
-    #: scene (mean bird, hard lower fingers, planar, 1 s; the largest
-    #: estimate): 0.14 mm at 1.4 ms, where hold and peak are within 1 % and
-    #: 2 % of the adaptive reference, 1.25 mm at 5.6 ms, where the peak is
-    #: 98 % high; checked on problems/grasp_football.yaml: 0.17 mm at 1.4 ms
-    #: (rise 13.8 mm, adaptive 13.4 mm), stopped at 0.95 s at 5.6 ms, and at
-    #: 16.6 ms (the thesis's football step) 6.1 mm unbounded, in a run that
-    #: ended `ok` with the ball thrown 3.9 m back at 4.2 m/s.
+    #: of the 10-20 mm lifts the thesis reports: a step size that meets the
+    #: accuracy targets stays under it, the thesis's own steps do not
+    #: (``python -m benchmarks.grasp``'s bdf4 rows, docs/performance.md).
     max_local_error: float = 1e-3
 
     def finer(self, factor: float = 4.0) -> "IntegratorSettings":
@@ -299,8 +291,7 @@ def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
     as it is found: past the crossing by depth / |g'| to 2 depth / |g'| (a
     reversal margin's slope is of order 1 m/s², so 1e-9 to 2e-9 s), without
     the evaluations brentq spends narrowing its bracket to 1e-12 s around a
-    function whose values near zero are Newton-tolerance noise (measured on
-    the grasp benchmark's 10 reversals: 82 evaluations against 100).
+    function whose values near zero are Newton-tolerance noise.
 
     Finger forces are continued from the latest solution, so g at the
     dense-output points may differ from the step's end values by the Newton

@@ -1,8 +1,8 @@
 """Finger-force maxima between the integrator's accepted instants.
 
 A finger's force is known at the accepted instants only, so its peak, read
-there, is low by up to half a step's worth of its curvature (2.9 % at 20 ms
-steps on the hard-finger mean bird). Where a finger's force at an accepted
+there, is low by up to half a step's worth of its curvature
+(tests/test_peaks.py compares located peaks with a much finer run). Where a finger's force at an accepted
 instant exceeds its neighbours', its maximum lies between them: it is found
 by successive parabolic interpolation on the steps' dense output, each
 trial a contact evaluation from the contacts accepted before the step that

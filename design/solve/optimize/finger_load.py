@@ -24,7 +24,7 @@ the rootfinder's start z0. Outputs: the load on the bird from both drums
 force clipped at zero (N; a contact that would pull lets go) and the
 contact's unknowns z (an output to read, declared not differentiable).
 
-How it is evaluated (issue 13): the function is three calls, the kinematics
+How it is evaluated: the function is three calls, the kinematics
 x -> q (SX), the rootfinder (z0, q) -> z and the loads (x, z) -> outputs
 (SX), and its Jacobian is given explicitly (``custom_jacobian``) by the
 implicit-function theorem at the solution z it already has,
@@ -35,19 +35,16 @@ implicit-function theorem at the solution z it already has,
 one sparse QR of R_zᵀ with the four outputs as right-hand sides (the
 adjoint λ) per stage, instead of CasADi's derivative of the rootfinder, which
 solved the contact again inside every derivative call and carried every
-seed through the kinematics' MX graph. Measured on the first NLP of
-problems/hold_time.yaml (617 finger stages): one constraint Jacobian
-0.31 -> 0.11 s CPU, the same to 9e-14 relative; the rootfinder is the
-same (Newton with line search, CasADi's sparse QR), with the residual's
-Jacobian compiled: the same iterates to the last bit.
+seed through the kinematics' MX graph (``python -m benchmarks.solve`` times
+the constraint Jacobian); the rootfinder is Newton with line search and
+CasADi's sparse QR, with the residual's Jacobian compiled.
 
 The NLP calls each finger and mode once per RK stage for all the intervals
 in that contact (:meth:`FingerLoad.batch`: CasADi's map over the stages,
 with the block-diagonal Jacobian of the stage Jacobians), and the batch
 remembers the contacts it solved (:class:`_Roots`), so the Jacobian that
 Ipopt asks for at the point whose constraints it has just evaluated solves
-no contact again: one Jacobian 0.106 -> 0.045 s CPU on the NLP above, the
-Ipopt solution identical to the last bit.
+no contact again, and Ipopt's iterates are the same as without the memory.
 
 The SX parts are generic in a constants vector c (the grasper's position
 and tilt, the bird's semi-axes, the finger's reference rigidity, mesh and
@@ -123,7 +120,7 @@ class PlanarStage:
     n_fixed = 8
     #: the implicit-function adjoint's linear solver (the residual Jacobian's sparsity)
     solver = "qr"
-    #: its stages are cheap (0.05 ms): serial
+    #: its stages are cheap next to a thread's hand-off: serial
     threads = 1
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,

@@ -11,7 +11,7 @@ the optimum still holds at least as long as the baseline and keeps the
 cap: the cap given as a rule (``baseline``, a fraction of it, or newtons)
 is resolved on the spatial baseline's own peak.
 
-The spatial runs (6-8 s CPU each on the main problem) go to one background
+The spatial runs (seconds each on the main problem) go to one background
 process, the baseline's at the start of the run while the optimiser works,
 the optimum's as soon as the design loop has picked it, so that they cost
 the run little wall time on a machine with a free core. The process is a

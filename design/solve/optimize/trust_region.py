@@ -15,9 +15,8 @@ direction that lengthens the hold first raises some finger's force, and on
 the fixed schedule the NLP only sees the local trade. With the margin, the
 first steps move to designs well inside the cap, where the simulation can
 find the different contact sequences (merged N = 0 windows) that hold
-longer, and the later steps use the slack as the margin closes. Measured on
-problems/hold_time.yaml: see README. The
-schedule (contact and belt modes) is rebuilt around every accepted design,
+longer, and the later steps use the slack as the margin closes
+(docs/design-method.md). The schedule (contact and belt modes) is rebuilt around every accepted design,
 so contacts the NLP could not see are found by the simulation.
 
 A candidate is accepted only if the optimiser's grid reproduces its
@@ -55,10 +54,10 @@ from design.solve.optimize.variables import DesignSpace
 #: verification tolerances: hold time (relative) and force over the cap (relative)
 HOLD_TOLERANCE, CAP_TOLERANCE = 0.02, 0.01
 #: Ipopt iterations allowed for the optimiser's view of a fixed design, and
-#: how many without progress in feasibility stop it (measured on
-#: problems/hold_time.yaml: the views that reproduced converged in 3 to 39
-#: iterations; the two that did not stalled at violations of 3.7e-2 and
-#: 8.6e-2 and were stopped after 58 and 41 iterations, 47 s and 93 s)
+#: how many without progress in feasibility stop it: a view that reproduces
+#: its simulation converges well within the limit, one that cannot stalls
+#: at a visible violation, and the stall test stops it early instead of
+#: letting it run to the limit
 VIEW_MAX_ITER, VIEW_STALL = 100, 15
 #: the NLP's cap is lowered by at most this factor per rejected candidate
 BACK_OFF = 0.9
