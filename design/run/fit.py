@@ -169,7 +169,7 @@ def run_finger(problem: FingerFitProblem, progress: Progress | None = None) -> R
     band = BAND_Z * c_sd / np.maximum(c, 1e-300)
     reach = data.reach
     determined = (knots <= reach + 1e-12) & (band <= DETERMINED_BAND)
-    warnings = []
+    warnings = [data.note] if data.note else []
     if reach < problem.length - 1e-9:
         warnings.append(f"EI(s) past s = {reach:.4g} m is not determined by the data: no load "
                         f"and no measured point lies beyond it, so no measurement depends on "
