@@ -107,6 +107,16 @@ def test_readings_past_their_bound_by_more_than_the_noise_allows_are_refused(
     assert f"bench.csv: {message}" in err
 
 
+def test_the_small_deflection_model_is_not_asked_to_fit_x_alone(tmp_path, capsys):
+    """x readings alone: the small-deflection model has nothing to fit (x = s
+    to first order), so asking for it is bad input, named by its field."""
+    rows = [f"0.5,90,100,{s},{s - 0.01:.4f},," for s in (25, 50, 75, 100)] * 2
+    extra = {"fit": {"method": "small-deflection", "noise": {"position": "0.1 mm"}}}
+    err = _rejected(tmp_path, capsys, _problem(tmp_path, rows, header=X_HEADER, extra=extra))
+    assert "fit.yaml: fit.method: small-deflection fits y and psi readings, and bench.csv has " \
+           "only x" in err
+
+
 def test_too_few_points_are_rejected(tmp_path, capsys):
     err = _rejected(tmp_path, capsys, _problem(tmp_path, GOOD_ROWS[:4]))
     assert "bench.csv: too few points: 4 measured values (x, y or psi); a finger fit needs " \

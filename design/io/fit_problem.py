@@ -172,6 +172,11 @@ def _finger_fit(reader: Reader, data: dict, base_dir: Path, name: str, descripti
     measured = None
     if path is not None and length is not None:
         measured = read_finger_data(reader, path, length, settings or FingerFitSettings())
+    if measured is not None and settings is not None and settings.method == "small-deflection" \
+            and all(o.quantity == "x" for o in measured.observations):
+        reader.add("fit.method", f"small-deflection fits y and psi readings, and {path.name} has "
+                                 f"only x (to first order a point moves across the finger, not "
+                                 f"along it): use auto or elastica")
     if not reader.ok or None in (name, description, length, settings, measured):
         return None
     return FingerFitProblem(name, path, measured, length, E, settings, reference, description)
