@@ -5,7 +5,7 @@ hung perpendicular to it at 50, 75 and 100 % of its length; four markers at
 25, 50, 75 and 100 % read for x and y (or one of them) with Gaussian noise of
 0.1 mm (numpy default_rng, a seed per bench). The readings are the exact
 elastica of the profile (the toolkit's collocation on 64 intervals, error
-estimate below 1e-3 of the noise), so the model explains them.
+estimate below 1e-3 of the noise, asserted), so the model explains them.
 
 The profiles (``FAMILY``) are smooth tapers, steps and inserts, each scaled
 so that the heaviest load bends the finger's tip to 55-70 deg. ``TUNING``

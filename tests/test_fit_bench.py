@@ -22,14 +22,13 @@ The tapers meet them all. On the other profiles (thickness falling as
 that what is claimed holds.
 
 The default suite runs one fit, the issue's moulded finger through the
-command; ``-m slow`` runs the whole family with each kind of reading (48
+command's run; ``-m slow`` runs the whole family with each kind of reading (48
 fits, about five minutes), and benchmarks/fit_bench.py tabulates it with
 times.
 """
 
 from __future__ import annotations
 
-import json
 import tempfile
 from functools import lru_cache
 from pathlib import Path
@@ -37,9 +36,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from design.cli import main
 from design.io.scene import load_fit
 from design.run.finger_fit import fit_finger, summarise
+from design.run.fit import run
 from tests.fit_benches import FAMILY, READINGS, readings, score, write_problem
 
 
@@ -61,12 +60,11 @@ def assert_recovered(name: str, knots, ei, low, high, determined, noise_scale, m
 @pytest.fixture(scope="module")
 def moulded_finger(tmp_path_factory):
     """The issue's moulded finger (150 mm, EI falling 30x) read for x and y,
-    through ``design fit``: exit status, result and the data file."""
-    folder = tmp_path_factory.mktemp("moulded")
-    path = write_problem(folder, "taper-30")
-    status = main(["fit", str(path), "--out", str(folder / "out"), "--quiet"])
-    result = json.loads((folder / "out" / "result.json").read_text())
-    return status, result, path.with_suffix(".csv").read_text()
+    through ``design fit``'s run (the command's exit status is its ``ok``):
+    the result and the data file."""
+    path = write_problem(tmp_path_factory.mktemp("moulded"), "taper-30")
+    output = run(load_fit(path))
+    return output.ok, output.result, path.with_suffix(".csv").read_text()
 
 
 def test_the_moulded_finger_is_fitted_from_noisy_readings(moulded_finger):
@@ -75,8 +73,8 @@ def test_the_moulded_finger_is_fitted_from_noisy_readings(moulded_finger):
     meets the module docstring's targets with the x and the y readings each
     determining EI on their own; the model file predicts the readings within
     the noise of the fit's predictions."""
-    status, result, csv = moulded_finger
-    assert status == 0 and result["ok"] and result["method"] == "elastica"
+    ok, result, csv = moulded_finger
+    assert ok and result["ok"] and result["method"] == "elastica"
     rows = [line.split(",") for line in csv.splitlines()[1:]]
     past = sum(np.hypot(float(x), float(y)) > float(s) or abs(float(x)) > float(s)
                for _, _, _, s, x, y in rows)
