@@ -169,8 +169,8 @@ def main() -> None:
                           "fits_ok": sum(r["ok"] for r in subset)}
     summary["wall_s_max"] = max(r["wall_s"] for r in rows)
     summary["wall_s_median"] = float(np.median([r["wall_s"] for r in rows]))
-    print(f"\nsmooth fits meeting the targets (EI within 10 %, band holding the truth at 90 % of "
-          f"the knots, over a judged span of half the finger or more): "
+    print("\nsmooth fits meeting the targets (EI within 10 %, band holding the truth at 90 % of "
+          "the knots, over a judged span of half the finger or more): "
           + ", ".join(f"{k} {v['smooth_meeting_targets']} of {v['smooth_fits']}"
                       for k, v in summary.items() if isinstance(v, dict)))
     write_results(RESULTS, {

@@ -144,7 +144,7 @@ class Bench:
 def _thesis_shape(length: float, root: float) -> Stiffness:
     """The thesis's hard finger's EI(s) (eq. 2.33, rates 71 and 142 1/m over
     203 mm) stretched to ``length`` and scaled to EI(0) = ``root``."""
-    E, A, B, C, a, b = 9.07e6, 7.3e-8, -3.6551e-8, 3.2102e-9, -70.87, -141.73
+    A, B, C, a, b = 7.3e-8, -3.6551e-8, 3.2102e-9, -70.87, -141.73
     k = 0.203 / length
     return ExponentialI(root / (A + B + C), A, B, C, a * k, b * k)
 

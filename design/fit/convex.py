@@ -70,7 +70,6 @@ class WeightedFit:
     roughness: float         # ‖D z‖
     trace: float             # tr H, the fit's effective number of parameters
     hat: np.ndarray          # diag H, (m,)
-    covariance: np.ndarray   # (AᵀA + λ DᵀD)⁻¹ at this weight (n, n)
 
     @property
     def gcv(self) -> float:
@@ -226,13 +225,12 @@ class CompliancePQ:
 def analyse(A: np.ndarray, y: np.ndarray, D: np.ndarray, lam: float, z: np.ndarray
             ) -> WeightedFit:
     """The solution z of min ‖A z - y‖² + λ ‖D z‖² (under whatever constraints)
-    with its influence matrix and covariance, both of the unconstrained
-    problem (see the module docstring)."""
-    cov = np.linalg.pinv(A.T @ A + lam * D.T @ D, hermitian=True)
-    H = A @ cov @ A.T
+    with its residuals and the influence matrix of the unconstrained problem
+    (see the module docstring)."""
+    H = A @ np.linalg.pinv(A.T @ A + lam * D.T @ D, hermitian=True) @ A.T
     r = A @ z - y
     return WeightedFit(lam, z, r, float(np.linalg.norm(D @ z)), float(np.trace(H)),
-                       np.diag(H).copy(), cov)
+                       np.diag(H).copy())
 
 
 def weight_grid(A: np.ndarray, D: np.ndarray) -> np.ndarray:
