@@ -7,8 +7,10 @@
   smoothness penalty whose weight generalised cross-validation (or the
   L-curve) picks, and its confidence band.
 * :mod:`design.fit.elastica`: predictions of the planar elastica at measured
-  points, and the nonlinear least-squares refinement on the collocated
-  elastica (CasADi + Ipopt) for large deflections.
+  points, the uniform EI that fits them best, and the nonlinear
+  least-squares problem on the collocated elastica (CasADi + Ipopt).
+* :mod:`design.fit.refinement`: the large-deflection fit of ln(1/EI) along a
+  path of weights, and its band.
 * :mod:`design.fit.exponential`: the thesis's exponential family
   EI = E (A e^(a s) + B e^(b s) + C) projected onto a fitted profile.
 * :mod:`design.fit.belt`: belt speed profiles from an encoder log.

@@ -70,7 +70,6 @@ class WeightedFit:
     roughness: float         # ‖D z‖
     trace: float             # tr H, the fit's effective number of parameters
     hat: np.ndarray          # diag H, (m,)
-    covariance: np.ndarray   # (AᵀA + λ DᵀD)⁻¹, the band's before σ̂² (n, n)
 
     @property
     def gcv(self) -> float:
@@ -81,15 +80,22 @@ class WeightedFit:
 
 @dataclass
 class Selection:
-    """A sweep of weights and the one its rule chose, with the sweep's cost."""
+    """A sweep of weights and the one its rule chose, with the sweep's cost,
+    and the least-squares problem it was chosen on: min ‖A z - y‖² + λ ‖D z‖²
+    (A = ``design``, the σ-scaled readings' sensitivity to the unknowns;
+    D = ``penalty``)."""
 
     chosen: WeightedFit
     sweep: list[WeightedFit]
     rule: str
-    solve_time_s: float       # every Clarabel call of the sweep, cvxpy's own time included
-    setup_time_s: float       # building the cvxpy problem (once)
+    solve_time_s: float       # every solve of the sweep (Clarabel with cvxpy's time, or Ipopt)
+    setup_time_s: float       # building the problem (once)
     solves: int
     status: str               # the solver statuses met, e.g. "optimal"
+    design: np.ndarray
+    penalty: np.ndarray
+    #: the band is taken at the chosen weight over this (1: at the chosen weight)
+    band_undersmoothing: float = 1.0
 
     @property
     def noise_scale(self) -> float:
@@ -97,9 +103,15 @@ class Selection:
         r, dof = self.chosen.residual, self.chosen.residual.size - self.chosen.trace
         return float(np.sqrt(r @ r / dof)) if dof > 0 else float("nan")
 
-    def z_sd(self) -> np.ndarray:
-        """Standard deviations of the scaled unknowns (the band's, / 1.96)."""
-        return self.noise_scale * np.sqrt(np.clip(np.diag(self.chosen.covariance), 0, None))
+    def z_sd(self, rows: np.ndarray | None = None) -> np.ndarray:
+        """Standard deviations of the scaled unknowns (the band's, / 1.96), at
+        the chosen weight over :attr:`band_undersmoothing`; with ``rows``
+        (indices into the readings used), those the band would have were only
+        these readings taken (same weight, same noise scale)."""
+        A = self.design if rows is None else self.design[rows]
+        weight = self.chosen.lam / self.band_undersmoothing
+        cov = np.linalg.pinv(A.T @ A + weight * self.penalty.T @ self.penalty, hermitian=True)
+        return self.noise_scale * np.sqrt(np.clip(np.diag(cov), 0, None))
 
     def studentised(self) -> np.ndarray:
         """r_i / (σ̂ sqrt(1 - H_ii)) of every measurement the fit used."""
@@ -117,11 +129,38 @@ class ProfileFit:
     method: str               # "small-deflection" or "elastica"
     knots: np.ndarray
     c: np.ndarray
-    c_sd: np.ndarray
+    sd: np.ndarray            # standard deviation of c (1/(N m²)), or of ln c if ``log``
     c_ref: float
     selection: Selection
     used: list[int]
     predictions: np.ndarray
+    log: bool = False
+
+    def ei_band(self) -> tuple[np.ndarray, np.ndarray]:
+        """The 95 % band of EI (N m²) at the knots: low, high (inf where the
+        band of c reaches 0)."""
+        if self.log:
+            return np.exp(-BAND_Z * self.sd) / self.c, np.exp(BAND_Z * self.sd) / self.c
+        low_c, high_c = self.c + BAND_Z * self.sd, self.c - BAND_Z * self.sd
+        return 1.0 / low_c, np.where(high_c > 0, 1.0 / np.maximum(high_c, 1e-300), np.inf)
+
+    @property
+    def band(self) -> np.ndarray:
+        """The band's relative half-width at each knot (see :meth:`relative`)."""
+        return self.relative(self.sd)
+
+    def band_from(self, rows: np.ndarray) -> np.ndarray:
+        """The relative half-width the band would have were only the readings
+        ``rows`` (indices into ``used``) taken."""
+        scale = 1.0 if self.log else self.c_ref
+        return self.relative(self.selection.z_sd(rows) * scale)
+
+    def relative(self, sd: np.ndarray) -> np.ndarray:
+        """BAND_Z sd / c; or, if ``log``, e^(BAND_Z sd) - 1, the band's upper
+        side (the wider)."""
+        if self.log:
+            return np.expm1(BAND_Z * sd)
+        return BAND_Z * sd / np.maximum(self.c, 1e-300)
 
     @property
     def lam(self) -> float:
@@ -180,14 +219,18 @@ class CompliancePQ:
         return self.analyse(lam, np.asarray(self.z.value)), self.problem.status
 
     def analyse(self, lam: float, z: np.ndarray) -> WeightedFit:
-        """Influence matrix and covariance of the solution z at weight lam
-        (both of the unconstrained problem: see the module docstring)."""
-        A, D = self.A, self.D
-        cov = np.linalg.pinv(A.T @ A + lam * D.T @ D, hermitian=True)
-        H = A @ cov @ A.T
-        r = A @ z - self.y
-        return WeightedFit(lam, z, r, float(np.linalg.norm(D @ z)), float(np.trace(H)),
-                           np.diag(H).copy(), cov)
+        return analyse(self.A, self.y, self.D, lam, z)
+
+
+def analyse(A: np.ndarray, y: np.ndarray, D: np.ndarray, lam: float, z: np.ndarray
+            ) -> WeightedFit:
+    """The solution z of min ‖A z - y‖² + λ ‖D z‖² (under whatever constraints)
+    with its residuals and the influence matrix of the unconstrained problem
+    (see the module docstring)."""
+    H = A @ np.linalg.pinv(A.T @ A + lam * D.T @ D, hermitian=True) @ A.T
+    r = A @ z - y
+    return WeightedFit(lam, z, r, float(np.linalg.norm(D @ z)), float(np.trace(H)),
+                       np.diag(H).copy())
 
 
 def weight_grid(A: np.ndarray, D: np.ndarray) -> np.ndarray:
@@ -231,7 +274,7 @@ def select_weight(A: np.ndarray, y: np.ndarray, monotone: str | None, rule: str
     if not sweep:
         raise RuntimeError(f"the convex fit failed at every weight ({', '.join(statuses)})")
     return Selection(pick(sweep, rule), sweep, rule, elapsed, setup, len(grid),
-                     ", ".join(sorted(statuses)))
+                     ", ".join(sorted(statuses)), A, qp.D)
 
 
 def compliance_scale(K: np.ndarray, y: np.ndarray, sigma: np.ndarray) -> float:

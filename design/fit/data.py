@@ -32,15 +32,16 @@ class Observation:
 @dataclass(frozen=True)
 class FingerData:
     """Load cases (each a :class:`~design.physics.beam.PointLoad`) and what
-    was measured under them."""
+    was measured under them, and the warning reading them raised (None: none)."""
 
     loads: tuple[PointLoad, ...]
     observations: tuple[Observation, ...]
+    note: str | None = None
 
     def subset(self, keep) -> "FingerData":
         """The observations for which ``keep(observation)`` is true (the load
         cases stay, so case indices keep their meaning)."""
-        return FingerData(self.loads, tuple(o for o in self.observations if keep(o)))
+        return FingerData(self.loads, tuple(o for o in self.observations if keep(o)), self.note)
 
     @property
     def values(self) -> np.ndarray:

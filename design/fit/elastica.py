@@ -1,4 +1,5 @@
-"""The planar elastica at measured points, and the large-deflection refinement.
+"""The planar elastica at measured points, the uniform finger that fits the
+readings best, and the refinement's nonlinear least-squares problem.
 
 Predictions: each load case is solved by the toolkit's collocation method
 (:class:`design.solve.beam.collocation.Collocation`) and read at the measured
@@ -6,34 +7,47 @@ arc lengths by cubic Hermite interpolation of x, y (slopes cos ψ, sin ψ) and
 ψ (slope M / EI) between its nodes; past the load point the finger is
 straight.
 
-Refinement: a nonlinear least-squares fit of the knot compliances on the
-collocated elastica, solved simultaneously (every load case's collocation
-unknowns are NLP unknowns, its collocation equations constraints) by Ipopt
-with exact derivatives from CasADi. The transcription is the toolkit's
+The refinement's problem (:class:`ElasticaFitProblem`): the log-compliances
+q = ln(c / c_ref) at the knots fitted to the readings on the collocated
+elastica, solved simultaneously (every load case's collocation unknowns are
+NLP unknowns, its collocation equations constraints) by Ipopt. The
+transcription is the toolkit's
 :class:`~design.solve.beam.collocation.BeamTranscription` with the stiffness
-:class:`~design.fit.kernel.KnotCompliance`, whose parameters are the knot
-compliances; each case's mesh has an interval edge at every knot (EI has a
-kink there) and at every measured point inside the loaded span, so a
-prediction is a mesh node's value, not an interpolation. Objective: the
-convex fit's, ½ ‖r / σ‖² + ½ λ ‖D c / c_ref‖², with its λ and constraints.
+:class:`~design.fit.kernel.KnotCompliance` (c piecewise linear between the
+knots, c = c_ref e^q at them: positive whatever step Ipopt tries); each
+case's mesh has an interval edge at every knot (EI has a kink there) and at
+every measured point inside the loaded span, so a prediction is a mesh
+node's value, not an interpolation. Objective ½ ‖r / σ‖² + ½ λ ‖D q‖², D
+the penalty's matrix (see :mod:`design.fit.refinement`).
+
+Ipopt is given the Gauss-Newton Hessian of the objective, Rᵀ R + λ DᵀD (R
+the residuals' Jacobian in all unknowns), not the exact Hessian of the
+Lagrangian: the generalised Gauss-Newton method of parameter estimation in
+collocated differential equations (Bock 1983). The exact one, with the
+collocation equations' curvature weighted by their multipliers, is
+indefinite away from a small-residual solution, and Ipopt's inertia
+correction then regularised it until the steps vanished ("error in step
+computation") on the tuning benches of tests/fit_benches.py; the
+Gauss-Newton one is positive semi-definite, so each step is a least-squares
+step on the linearised elastica.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
 import scipy.sparse as sp
 from scipy.interpolate import CubicHermiteSpline
+from scipy.optimize import minimize_scalar
 from scipy.sparse.linalg import spsolve
 
-from design.fit.convex import (PER_DECADE, CompliancePQ, ProfileFit, roughness,
-                               select_weight)
 from design.fit.data import FingerData
 from design.fit.kernel import KnotCompliance
 from design.physics.beam import BeamSolution, Finger
+from design.physics.stiffness import UniformEI
 from design.solve.beam.collocation import Collocation, legendre_tables, transcription
 
 #: collocation degree of the refinement's transcription (nodal order 2d = 6;
@@ -41,6 +55,9 @@ from design.solve.beam.collocation import Collocation, legendre_tables, transcri
 DEGREE = 3
 #: intervals of each case's mesh beyond those its knots and points need
 SPARE_INTERVALS = 8
+#: the uniform fit's grid: the EI at which the heaviest load's F a² / EI is
+#: 10^k, k over this range in half decades (from barely bent to folded)
+UNIFORM_DECADES = (-2.0, 2.0)
 
 
 def points_on(sol: BeamSolution, finger: Finger, s: np.ndarray) -> dict[str, np.ndarray]:
@@ -72,6 +89,47 @@ def elastica_predictions(finger: Finger, data: FingerData, nodes: int = 16
         for j, i in enumerate(idx):
             out[i] = pts[data.observations[i].quantity][j]
     return out, sols
+
+
+@dataclass
+class UniformFit:
+    """The uniform EI (N m²) whose elastica fits the readings best, its load
+    cases' solutions, the σ-scaled residuals' sum of squares, the elastica
+    solves it took and its time (s)."""
+
+    ei: float
+    solutions: list[BeamSolution]
+    chi2: float
+    evaluations: int
+    time_s: float
+
+
+def uniform_fit(data: FingerData, length: float) -> UniformFit:
+    """Least squares of one uniform EI on the elastica: the best of a log
+    grid (:data:`UNIFORM_DECADES`), then Brent's method on ln EI within half
+    a decade of it. Any readings do (x alone included); nothing is taken
+    from the small-deflection model."""
+    t0 = time.perf_counter()
+    scale = max(ld.force * abs(np.sin(ld.alpha)) * ld.at ** 2 for ld in data.loads)
+    seen: dict[float, tuple[float, list[BeamSolution]]] = {}
+
+    def chi2(log_ei: float) -> float:
+        pred, sols = elastica_predictions(Finger(length, UniformEI(float(np.exp(log_ei)))), data)
+        value = float(np.sum(((pred - data.values) / data.sigmas) ** 2))
+        if not (np.isfinite(value) and all(s.converged for s in sols)):
+            value = np.inf
+        seen[float(log_ei)] = (value, sols)
+        return value
+
+    lo, hi = UNIFORM_DECADES
+    grid = np.log(scale) - np.log(10.0) * np.arange(lo, hi + 0.25, 0.5)
+    best = min(grid, key=chi2)
+    half = 0.5 * np.log(10.0)
+    minimize_scalar(chi2, bounds=(best - half, best + half), method="bounded",
+                    options={"xatol": 1e-4})
+    log_ei = min(seen, key=lambda k: seen[k][0])
+    value, sols = seen[log_ei]
+    return UniformFit(float(np.exp(log_ei)), sols, value, len(seen), time.perf_counter() - t0)
 
 
 def case_mesh(knots: np.ndarray, at: float, points: list[float], intervals: int
@@ -130,15 +188,17 @@ class IpoptSolve:
 class ElasticaFitProblem:
     """The refinement's NLP, built once; the weight λ is its parameter.
 
-    Unknowns: z = c / c_ref at the knots, then for each load case its
+    Unknowns: q = ln(c / c_ref) at the knots, then for each load case its
     collocation unknowns and the x, y of its mesh edges. Objective
-    ½ ‖r / σ‖² + ½ λ ‖D z‖²; constraints: the collocation equations, the
-    edges' quadrature, z ≥ 1e-6 (EI finite) and the monotonicity asked for.
+    ½ ‖r / σ‖² + ½ λ ‖D q‖² (D = ``penalty``); constraints: the collocation
+    equations, the edges' quadrature and the monotonicity asked for. It
+    starts from the profile ``c_start`` (1/(N m²) at ``knots``) and its load
+    cases' solutions ``start``.
     """
 
     def __init__(self, data: FingerData, length: float, knots: np.ndarray,
                  c_start: np.ndarray, c_ref: float, monotone: str | None,
-                 start: list[BeamSolution], max_iter: int = 200):
+                 start: list[BeamSolution], penalty: np.ndarray, max_iter: int = 200):
         t0 = time.perf_counter()
         self.c_ref, self.n = c_ref, knots.size
         stiff0 = KnotCompliance(tuple(knots), tuple(c_start))
@@ -149,9 +209,9 @@ class ElasticaFitProblem:
                 for ld, pts in zip(data.loads, per_case)) + SPARE_INTERVALS
         tr = transcription(stiff0, K, DEGREE)
         tables = legendre_tables(DEGREE)
-        z = ca.SX.sym("z", self.n)
+        q = ca.SX.sym("q", self.n)
         lam = ca.SX.sym("lam")
-        c = c_ref * z
+        c = c_ref * ca.exp(q)
         ws, w0, G = [], [], []
         pred = [None] * len(obs)
         for k, (load, sol) in enumerate(zip(data.loads, start)):
@@ -165,7 +225,7 @@ class ElasticaFitProblem:
             ws.append(ca.vertcat(w, xs[1:], ys[1:]))
             G.append(closure)
             w0.append(np.concatenate([tr.guess(sol, ei_ref, widths),
-                                      *(points_on(sol, finger0, edges[1:])[q] for q in "xy")]))
+                                      *(points_on(sol, finger0, edges[1:])[v] for v in "xy")]))
             for i, o in enumerate(obs):
                 if o.case != k:
                     continue
@@ -175,31 +235,37 @@ class ElasticaFitProblem:
                            "y": ys[e] + ahead * ca.sin(psis[e]), "psi": psis[e]}[o.quantity]
         pred_v = ca.vertcat(*pred)
         r = (pred_v - data.values) / data.sigmas
-        D = ca.DM(roughness(self.n))
-        f = 0.5 * ca.sumsqr(r) + 0.5 * lam * ca.sumsqr(ca.mtimes(D, z))
+        D = ca.DM(penalty)
+        f = 0.5 * ca.sumsqr(r) + 0.5 * lam * ca.sumsqr(ca.mtimes(D, q))
         wall = ca.vertcat(*ws)
         eqs = ca.vertcat(*G)
         g, lbg, ubg = [eqs], [np.zeros(eqs.shape[0])], [np.zeros(eqs.shape[0])]
         if monotone in ("decreasing", "increasing"):
-            g.append(z[1:] - z[:-1])
+            g.append(q[1:] - q[:-1])
             lo, hi = (0.0, np.inf) if monotone == "decreasing" else (-np.inf, 0.0)
             lbg.append(np.full(self.n - 1, lo))
             ubg.append(np.full(self.n - 1, hi))
-        x_all = ca.vertcat(z, wall)
+        x_all = ca.vertcat(q, wall)
+        g_all = ca.vertcat(*g)
         self.unknowns = int(x_all.shape[0])
+        R = ca.jacobian(r, x_all)
+        Dx = ca.horzcat(D, ca.DM(D.shape[0], x_all.shape[0] - self.n))
+        gauss_newton = ca.mtimes(R.T, R) + lam * ca.mtimes(Dx.T, Dx)
+        weight_f, weight_g = ca.SX.sym("lam_f"), ca.SX.sym("lam_g", g_all.shape[0])
+        hessian = ca.Function("nlp_hess_l", [x_all, lam, weight_f, weight_g],
+                              [ca.triu(weight_f * gauss_newton)],
+                              ["x", "p", "lam_f", "lam_g"], ["triu_hess_gamma_x_x"])
         self.solver = ca.nlpsol("elastica_fit", "ipopt",
-                                {"x": x_all, "p": lam, "f": f, "g": ca.vertcat(*g)},
-                                {"ipopt.print_level": 0, "print_time": False, "ipopt.sb": "yes",
+                                {"x": x_all, "p": lam, "f": f, "g": g_all},
+                                {"hess_lag": hessian, "ipopt.print_level": 0,
+                                 "print_time": False, "ipopt.sb": "yes",
                                  "ipopt.max_iter": max_iter, "ipopt.tol": 1e-9})
-        self.bounds = {"lbx": np.concatenate([np.full(self.n, 1e-6),
-                                              np.full(wall.shape[0], -np.inf)]),
-                       "ubx": np.full(self.unknowns, np.inf),
-                       "lbg": np.concatenate(lbg), "ubg": np.concatenate(ubg)}
-        self.x = np.concatenate([np.clip(c_start / c_ref, 0.1, 10.0), *w0])
-        # the σ-scaled residuals' sensitivity to z with the collocation
-        # equations held (implicit function theorem): J = R_z - R_w G_w⁻¹ G_z
-        self._sensitivity = ca.Function("fit_sensitivity", [z, wall], [
-            r, ca.jacobian(r, z), ca.jacobian(r, wall), ca.jacobian(eqs, z),
+        self.bounds = {"lbg": np.concatenate(lbg), "ubg": np.concatenate(ubg)}
+        self.x = np.concatenate([np.log(c_start / c_ref), *w0])
+        # the σ-scaled residuals' sensitivity to q with the collocation
+        # equations held (implicit function theorem): J = R_q - R_w G_w⁻¹ G_q
+        self._sensitivity = ca.Function("fit_sensitivity", [q, wall], [
+            r, ca.jacobian(r, q), ca.jacobian(r, wall), ca.jacobian(eqs, q),
             ca.jacobian(eqs, wall), pred_v])
         self.build_time_s = time.perf_counter() - t0
 
@@ -214,67 +280,14 @@ class ElasticaFitProblem:
                           int(stats.get("iter_count", 0)), elapsed)
 
     @property
-    def z(self) -> np.ndarray:
+    def q(self) -> np.ndarray:
         return self.x[:self.n]
 
     def linearised(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """At the current solution: σ-scaled residuals r, their Jacobian J in z,
-        and the predictions (data order); r(z') ≈ r + J (z' - z)."""
-        r, Rz, Rw, Gz, Gw, pred = self._sensitivity(self.z, self.x[self.n:])
-        dw = spsolve(sp.csc_matrix(Gw.sparse()), sp.csc_matrix(Gz.sparse()))
+        """At the current solution: σ-scaled residuals r, their Jacobian J in q,
+        and the predictions (data order); r(q') ≈ r + J (q' - q)."""
+        r, Rq, Rw, Gq, Gw, pred = self._sensitivity(self.q, self.x[self.n:])
+        dw = spsolve(sp.csc_matrix(Gw.sparse()), sp.csc_matrix(Gq.sparse()))
         dw = dw.toarray() if sp.issparse(dw) else np.asarray(dw).reshape(-1, self.n)
-        J = np.asarray(Rz) - sp.csr_matrix(Rw.sparse()) @ dw
+        J = np.asarray(Rq) - sp.csr_matrix(Rw.sparse()) @ dw
         return np.asarray(r).ravel(), np.asarray(J), np.asarray(pred).ravel()
-
-
-@dataclass
-class Refinement:
-    """The elastica fit and how it went: every Ipopt solve (one per weight
-    tried), the NLP's size and build time."""
-
-    fit: ProfileFit
-    solves: list[IpoptSolve]
-    unknowns: int
-    build_time_s: float
-
-    @property
-    def success(self) -> bool:
-        return bool(self.solves) and self.solves[-1].success
-
-
-#: at most this many weight updates (Ipopt solves) in the refinement
-MAX_WEIGHT_UPDATES = 4
-
-
-def refine(data: FingerData, length: float, start_fit: ProfileFit, monotone: str | None,
-           start: list[BeamSolution], rule: str = "gcv") -> Refinement:
-    """Nonlinear least squares of the knot compliances on the collocated
-    elastica, from the convex fit ``start_fit`` and the elastica solutions
-    ``start`` of its profile (one per load case).
-
-    The weight is chosen by the convex fit's rule on the problem linearised
-    at the refined solution (Gauss-Newton: r(z) ≈ r* + J (z - z*), the same
-    QP with A = J), and the refinement repeated from its last solution until
-    the rule picks the weight it was solved at (at most
-    :data:`MAX_WEIGHT_UPDATES` times): the convex fit's weight suits the
-    linear model's misfit, not the elastica's.
-    """
-    problem = ElasticaFitProblem(data, length, start_fit.knots, start_fit.c, start_fit.c_ref,
-                                 monotone, start)
-    lam, solves, sel = start_fit.lam, [], None
-    for _ in range(MAX_WEIGHT_UPDATES):
-        solves.append(problem.solve(lam))
-        r, J, pred = problem.linearised()
-        sel = select_weight(J, J @ problem.z - r, monotone, rule)
-        # the grid moves with J: the same weight is one within a grid step
-        if not solves[-1].success or abs(np.log10(sel.chosen.lam / lam)) < 0.5 / PER_DECADE:
-            break
-        lam = sel.chosen.lam
-    c_ref = start_fit.c_ref
-    # the fit's statistics at the weight it was solved at and its own solution
-    chosen = replace(sel, chosen=CompliancePQ(J, J @ problem.z - r, monotone).analyse(
-        solves[-1].lam, problem.z))
-    fit = ProfileFit("elastica", start_fit.knots, problem.z * c_ref,
-                     chosen.z_sd() * c_ref, c_ref, chosen,
-                     list(range(len(data.observations))), pred)
-    return Refinement(fit, solves, problem.unknowns, problem.build_time_s)

@@ -28,8 +28,13 @@ comments; one row per measured point under one load):
 is F (-cos α, sin α) in the finger frame, 90 deg a push towards +y), ``at``
 the load's arc length, ``s`` the measured point's arc length, and at least
 one of ``x``, ``y`` (the point's position in the finger frame, y the
-deflection) and ``psi`` (the finger's slope there). Belt columns: ``t``
-(strictly increasing) and ``v`` (≥ 0).
+deflection) and ``psi`` (the finger's slope there). A reading is checked
+against physics within its noise: a point lies within its arc length s of
+the clamp and a slope within half a turn, and a reading past that bound by
+more than :data:`BOUND_SIGMAS` standard deviations of the stated noise is
+refused; nearer, it is noise on a true value within the bound, fitted as
+read, and a warning counts such rows. Belt columns: ``t`` (strictly
+increasing) and ``v`` (≥ 0).
 """
 
 from __future__ import annotations
@@ -60,9 +65,13 @@ FINGER_COLUMNS = {"F": ("force", True), "alpha": ("angle", True), "at": ("length
                   "s": ("length", True), "x": ("length", False), "y": ("length", False),
                   "psi": ("angle", False)}
 BELT_COLUMNS = {"t": ("time", True), "v": ("speed", True)}
-#: fewest measured deflections or slopes a finger fit takes (a profile and
-#: the noise behind it cannot come from fewer)
+#: fewest measured values a finger fit takes (a profile and the noise
+#: behind it cannot come from fewer)
 MIN_FINGER_VALUES = 6
+#: a reading may pass its physical bound (|x| ≤ s, ...) by this many standard
+#: deviations of its stated noise and still be a reading of a true value
+#: within it: the chance of Gaussian noise reaching 5 σ is 3e-7 per reading
+BOUND_SIGMAS = 5.0
 #: fewest samples a belt fit takes (four parameters and the noise)
 MIN_BELT_SAMPLES = 8
 
@@ -163,6 +172,11 @@ def _finger_fit(reader: Reader, data: dict, base_dir: Path, name: str, descripti
     measured = None
     if path is not None and length is not None:
         measured = read_finger_data(reader, path, length, settings or FingerFitSettings())
+    if measured is not None and settings is not None and settings.method == "small-deflection" \
+            and all(o.quantity == "x" for o in measured.observations):
+        reader.add("fit.method", f"small-deflection fits y and psi readings, and {path.name} has "
+                                 f"only x (to first order a point moves across the finger, not "
+                                 f"along it): use auto or elastica")
     if not reader.ok or None in (name, description, length, settings, measured):
         return None
     return FingerFitProblem(name, path, measured, length, E, settings, reference, description)
@@ -255,6 +269,7 @@ def read_finger_data(reader: Reader, path: Path, length: float,
     rows = list(zip(*(table[k] for k in ("F", "alpha", "at", "s", "x", "y", "psi", "_line"))))
     cases: dict[tuple, int] = {}
     obs = []
+    beyond: list[tuple[int, float]] = []      # (line, excess in σ) within the bound's allowance
     for F, alpha, at, s, x, y, psi, line in rows:
         where = f"line {line}"
         ok = True
@@ -270,16 +285,12 @@ def read_finger_data(reader: Reader, path: Path, length: float,
         if x is None and y is None and psi is None:
             sub.add(where, "no measured value: give x, y or psi")
             ok = False
-        for key, value in (("x", x), ("y", y)):
-            if value is not None and abs(value) > s + 1e-12:
-                sub.add(f"{where}, {key}", f"|{value:g}| m is more than the point's arc length "
-                                           f"s = {s:g} m: accepted range "
-                                           f"{interval(-s, s, False, False)} m")
+        for bound in physical_bounds(s, x, y, psi, settings):
+            if bound.excess > BOUND_SIGMAS * bound.sigma:
+                sub.add(f"{where}, {bound.column}", bound.refusal())
                 ok = False
-        if psi is not None and abs(psi) >= np.pi:
-            sub.add(f"{where}, psi", f"{psi:g} rad is outside the accepted range "
-                                     f"{interval(-np.pi, np.pi, True, True)} rad")
-            ok = False
+            elif bound.excess > 0:
+                beyond.append((line, bound.excess / bound.sigma))
         if not ok:
             continue
         k = cases.setdefault((F, alpha, at), len(cases))
@@ -287,10 +298,9 @@ def read_finger_data(reader: Reader, path: Path, length: float,
             if value is not None:
                 sigma = settings.noise_slope if quantity == "psi" else settings.noise_position
                 obs.append(Observation(k, s, quantity, value, sigma, line))
-    bending = [o for o in obs if o.quantity != "x"]
-    if sub.ok and len(bending) < MIN_FINGER_VALUES:
-        sub.add("", f"too few points: {len(bending)} measured deflections (y) or slopes (psi); "
-                    f"a finger fit needs at least {MIN_FINGER_VALUES}")
+    if sub.ok and len(obs) < MIN_FINGER_VALUES:
+        sub.add("", f"too few points: {len(obs)} measured values (x, y or psi); a finger fit "
+                    f"needs at least {MIN_FINGER_VALUES}")
     if sub.ok and all(F * abs(math.sin(alpha)) == 0 for F, alpha, _ in cases):
         sub.add("F", "every load is zero or along the finger: nothing bends it")
     for problem in sub.problems:
@@ -298,7 +308,65 @@ def read_finger_data(reader: Reader, path: Path, length: float,
     if not sub.ok:
         return None
     loads = tuple(PointLoad(F, alpha, at) for F, alpha, at in cases)
-    return FingerData(loads, tuple(obs))
+    return FingerData(loads, tuple(obs), beyond_bound_note(beyond))
+
+
+@dataclass(frozen=True)
+class Bound:
+    """A reading against its physical bound: ``shown`` (the reading as the
+    message gives it) is ``excess`` past ``bound`` (m or rad), the largest
+    value its true value can have (``what``); ``sigma`` is the stated noise,
+    set by ``noise_key``."""
+
+    column: str
+    shown: str
+    bound: float
+    excess: float
+    sigma: float
+    what: str
+    noise_key: str
+
+    def refusal(self) -> str:
+        unit = "rad" if self.column == "psi" else "m"
+        limit = self.bound + BOUND_SIGMAS * self.sigma
+        return (f"{self.shown} {unit} is more than {self.what} {self.bound:g} {unit} by "
+                f"{self.excess / self.sigma:.3g} standard deviations of the stated noise "
+                f"({self.noise_key} = {self.sigma:g} {unit}): accepted range "
+                f"{interval(-limit, limit, False, False)} {unit} (the bound widened by "
+                f"{BOUND_SIGMAS:g} standard deviations)")
+
+
+def physical_bounds(s: float, x: float | None, y: float | None, psi: float | None,
+                    settings: FingerFitSettings) -> list[Bound]:
+    """Each reading of one row against what its true value cannot exceed: a
+    point at arc length s lies within s of the clamp (|x|, |y| and
+    sqrt(x² + y²) at most s), a slope within half a turn (|ψ| ≤ π)."""
+    pos, slope = settings.noise_position, settings.noise_slope
+    out = [Bound(key, f"|{value:g}|", s, abs(value) - s, pos, "the point's arc length s =",
+                 "fit.noise.position")
+           for key, value in (("x", x), ("y", y)) if value is not None]
+    if x is not None and y is not None:
+        r = math.hypot(x, y)
+        out.append(Bound("x, y", f"the distance from the clamp sqrt(x² + y²) = {r:g}", s, r - s,
+                         pos, "the point's arc length s =", "fit.noise.position"))
+    if psi is not None:
+        out.append(Bound("psi", f"|{psi:g}|", np.pi, abs(psi) - np.pi, slope, "half a turn,",
+                         "fit.noise.slope"))
+    return out
+
+
+def beyond_bound_note(beyond: list[tuple[int, float]]) -> str | None:
+    """The warning that counts the rows with readings past their physical
+    bound by no more than :data:`BOUND_SIGMAS` standard deviations: taken as
+    noise, they are fitted as read. ``beyond``: (line, excess in σ) of each."""
+    if not beyond:
+        return None
+    lines = sorted({line for line, _ in beyond})
+    shown = ", ".join(str(v) for v in lines[:20]) + (", ..." if len(lines) > 20 else "")
+    return (f"{len(lines)} row(s) read a point farther from the clamp than its arc length s, "
+            f"or a slope past ±180 deg, by up to {max(e for _, e in beyond):.2g} standard "
+            f"deviations of the stated noise (at most {BOUND_SIGMAS:g} accepted): taken as "
+            f"noise and fitted as read (lines {shown})")
 
 
 def read_table(reader: Reader, path: Path, columns: dict[str, tuple[str, bool]]

@@ -11,6 +11,7 @@ from design.fit.convex import FLAG_LIMIT
 from design.report.page import Page
 
 MM = 1e3
+READING_NAMES = {"x": "x", "y": "y", "psi": "slope"}
 
 
 def _closing(page: Page, result: dict) -> None:
@@ -30,35 +31,57 @@ def _warnings(page: Page, warnings: list[str]) -> None:
 
 
 def finger_page(result: dict, artifacts: dict) -> Page:
-    problem, fit = artifacts["problem"], artifacts["fit"]
-    data = problem.data
     page = Page(f"Finger fit: {result['name']}")
     if result["ok"]:
         page.banner(f"EI(s) fitted by the {result['method']} model to {result['measurements']} "
                     f"measured values; model written to finger.yaml", "passed")
     else:
         page.banner("The fit did not succeed: see the warnings", "failed")
+    _method(page, result, artifacts["fit"])
+    _warnings(page, result["warnings"])
+    _profile(page, result, artifacts)
+    _residuals(page, result, artifacts)
+    _weight(page, artifacts["fit"])
+    _closing(page, result)
+    return page
+
+
+def _method(page: Page, result: dict, fit) -> None:
+    """How the fit was made: the model and why, each solver's work, the noise."""
     page.section("Method", "method")
-    cv = result["convex"]
     page.text(f"Model used: {result['method']}. Why: {result['method_reason']}.")
-    page.text(f"Convex step: compliance c = 1/EI on {cv['knots']} knots, c ≥ 0"
-              f"{', EI monotone ' + cv['monotone'] if cv['monotone'] else ''}, roughness "
-              f"penalty weighted by {cv['weight_rule']} (weight {cv['weight']:.4g} of "
-              f"{cv['weights_tried']} tried); solver {cv['solver']}: {cv['why']}. "
-              f"Solve time {cv['solve_time_s']:.3f} s for the sweep, status {cv['status']}.")
+    cv = result["convex"]
+    if cv:
+        page.text(f"Convex step: compliance c = 1/EI on {cv['knots']} knots, c ≥ 0"
+                  f"{', EI monotone ' + cv['monotone'] if cv['monotone'] else ''}, roughness "
+                  f"penalty weighted by {cv['weight_rule']} (weight {cv['weight']:.4g} of "
+                  f"{cv['weights_tried']} tried); solver {cv['solver']}: {cv['why']}. "
+                  f"Solve time {cv['solve_time_s']:.3f} s for the sweep, status {cv['status']}.")
     el = result["elastica"]
     if el:
+        st = el["start"]
         solves = "; ".join(f"weight {s['weight']:.4g}: {s['status']}, {s['iterations']} "
                            f"iterations, {s['time_s']:.3f} s" for s in el["solves"])
-        page.text(f"Elastica refinement: {el['solver']}, {el['unknowns']} unknowns, built in "
-                  f"{el['build_time_s']:.2f} s; {solves}. The weight is re-chosen by "
-                  f"{cv['weight_rule']} on the elastica linearised at each solution.")
+        page.text(f"Elastica refinement of ln c at the knots (penalty on its second "
+                  f"differences): started from the uniform EI that fits the readings on the "
+                  f"elastica, {st['uniform_EI']:.4g} N m² ({st['elastica_solves']} elastica "
+                  f"solves, {st['time_s']:.2f} s); {el['solver']}, {el['unknowns']} unknowns, "
+                  f"built in {el['build_time_s']:.2f} s; weights from large to small, each "
+                  f"solve starting from the last: {solves}. The path ended because "
+                  f"{el['path_ended']}; weight {el['weight']:.4g} chosen by "
+                  f"{fit.selection.rule} on the elastica linearised at each solution.")
+    rms = ", ".join(f"{q}: {np.degrees(v):.3g} deg" if q == "psi" else f"{q}: {v * MM:.3g} mm"
+                    for q, v in result["rms_residual"].items())
     page.text(f"Noise: the residuals are {fit.selection.noise_scale:.3g} times the stated "
-              f"standard deviations; RMS residuals "
-              + ", ".join(f"{q}: {v:.3g} {'rad' if q == 'psi' else 'm'}"
-                          for q, v in result["rms_residual"].items()) + ".")
-    _warnings(page, result["warnings"])
+              f"standard deviations; RMS residuals {rms}.")
+
+
+def _profile(page: Page, result: dict, artifacts: dict) -> None:
+    """EI(s) with its band, the model file's, the reference, and which readings determine it."""
+    problem = artifacts["problem"]
     page.section("Fitted EI(s)", "profile")
+    page.text("Which readings determine EI(s) (its band within ±25 % from them alone): "
+              + determination_text(result["determined_by"]) + ".")
     prof = result["profile"]
     s = np.asarray(prof["s"])
     fig = Figure(figsize=(8, 4.4))
@@ -86,38 +109,62 @@ def finger_page(result: dict, artifacts: dict) -> Page:
     ax.legend(fontsize=8)
     page.figure(fig, "ei_profile", "Fitted EI(s) with its 95 % band (grey: where the data "
                 "determine it, band within ±25 %)")
+
+
+def determination_text(determined_by: dict) -> str:
+    """Which readings determined which part of EI(s), in words (intervals in mm)."""
+    def where(intervals):
+        return ", ".join(f"[{a * MM:.4g}, {b * MM:.4g}] mm" for a, b in intervals) or "nowhere"
+
+    parts = [f"the {READING_NAMES[q]} readings alone on {where(v)}"
+             for q, v in determined_by.items() if q != "together"]
+    if "together" in determined_by:
+        parts.append(f"only all of them together on {where(determined_by['together'])}")
+    return "; ".join(parts)
+
+
+def _residuals(page: Page, result: dict, artifacts: dict) -> None:
+    """Readings against predictions, the studentised residuals, the flagged readings."""
+    data, fit = artifacts["problem"].data, artifacts["fit"]
     page.section("Measured against predicted", "residuals")
     obs = data.observations
     pred = np.array(result_predictions(result, artifacts))
-    student = artifacts["fit"].studentised
+    student = fit.studentised
     fig = Figure(figsize=(12, 4.4))
     left, right = fig.subplots(1, 2)
-    for k, load in enumerate(data.loads):
-        idx = [i for i, o in enumerate(obs) if o.case == k and o.quantity == "y"]
-        if not idx:
-            continue
-        order = sorted(idx, key=lambda i: obs[i].s)
-        line = left.plot([obs[i].s * MM for i in order], [pred[i] * MM for i in order], "-",
-                         lw=1)[0]
-        left.plot([obs[i].s * MM for i in order], [obs[i].value * MM for i in order], "o",
-                  ms=3, color=line.get_color())
+    for k in range(len(data.loads)):
+        for q, mark in (("y", "o"), ("x", "s")):
+            idx = sorted((i for i, o in enumerate(obs) if o.case == k and o.quantity == q),
+                         key=lambda i: obs[i].s)
+            if not idx:
+                continue
+            value = (lambda i: obs[i].value) if q == "y" else (lambda i: obs[i].s - obs[i].value)
+            guess = (lambda i: pred[i]) if q == "y" else (lambda i: obs[i].s - pred[i])
+            line = left.plot([obs[i].s * MM for i in idx], [guess(i) * MM for i in idx],
+                             "-" if q == "y" else ":", lw=1)[0]
+            left.plot([obs[i].s * MM for i in idx], [value(i) * MM for i in idx], mark,
+                      ms=3, color=line.get_color(), mfc="none" if q == "x" else None)
     left.set_xlabel("measured point s (mm)")
-    left.set_ylabel("deflection y (mm)")
-    left.set_title("points: measured; lines: predicted", fontsize=9)
-    used = fit.used
+    left.set_ylabel("deflection y; shortening s - x (mm)")
+    left.set_title("points: measured (o y, □ s - x); lines: predicted", fontsize=9)
     right.axhspan(-FLAG_LIMIT, FLAG_LIMIT, color="0.92")
-    right.plot(range(len(used)), student, ".", ms=4)
+    right.plot(range(len(fit.used)), student, ".", ms=4)
     bad = np.abs(student) > FLAG_LIMIT
     right.plot(np.flatnonzero(bad), student[bad], "rx", label="flagged")
     right.set_xlabel("measurement (data order)")
     right.set_ylabel("studentised residual")
     right.legend(fontsize=8)
-    page.figure(fig, "residuals", "Deflections of every load case, measured and predicted; "
-                f"studentised residuals (flagged beyond ±{FLAG_LIMIT:g})")
+    page.figure(fig, "residuals", "Deflections and shortenings of every load case, measured "
+                f"and predicted; studentised residuals (flagged beyond ±{FLAG_LIMIT:g})")
     if result["flagged"]:
         page.table([{"line": f["line"], "quantity": f["quantity"], "measured": f["measured"],
                      "predicted": f["predicted"], "studentised": f["studentised"]}
-                    for f in result["flagged"]], "Badly fitted measurements", "flagged-table")
+                    for f in result["flagged"]], "Badly fitted measurements (SI)",
+                   "flagged-table")
+
+
+def _weight(page: Page, fit) -> None:
+    """The weight's choice: GCV and the L-curve along the sweep or path."""
     page.section("Choice of the weight", "weight")
     sweep = fit.selection.sweep
     fig = Figure(figsize=(12, 4))
@@ -132,11 +179,9 @@ def finger_page(result: dict, artifacts: dict) -> Page:
     ch = fit.selection.chosen
     lc.loglog([np.linalg.norm(ch.residual)], [ch.roughness], "ro")
     lc.set_xlabel("‖r / σ‖")
-    lc.set_ylabel("‖D c / c_ref‖")
+    lc.set_ylabel("‖D c / c_ref‖" if not fit.log else "‖D ln c‖")
     page.figure(fig, "weight", f"The weight sweep of the {fit.method} fit: GCV and the L-curve "
                 f"(red: chosen by {fit.selection.rule})")
-    _closing(page, result)
-    return page
 
 
 def result_predictions(result: dict, artifacts: dict) -> list[float]:

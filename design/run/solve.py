@@ -196,8 +196,8 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
                                        optimum=entries[0]["case"])
     if problem.robustness and optimum:
         with profile.phase(ROBUSTNESS):
-            robust = robustness.table(check.summaries(ROBUST_BASELINE),
-                                      check.summaries(ROBUST_OPTIMUM), float(caps[0][0]))
+            robust = robustness.table(check.runs(ROBUST_BASELINE), check.runs(ROBUST_OPTIMUM),
+                                      float(caps[0][0]))
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
                          baseline, t0, model_check)

@@ -43,6 +43,10 @@ from design.solve.contact.spatial import CHORD_ITERATIONS
 EVENT_DEPTH = 1e-8
 #: ... or this fraction of the continuation step
 EVENT_STEP = 1e-6
+#: a first touch of the bird found in one mode's discretisation may pull in the
+#: contact mode's, which puts the surface a few micrometres elsewhere: the
+#: finger then grazes the bird, without force, until it is this far (m) inside
+GRAZE_DEPTH = 2e-5
 #: the finger's modes that touch the bird, and those that touch the belt
 BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
 BELT_MODES = ("belt", "tip+belt", "interior+belt")
@@ -96,6 +100,9 @@ class Belted:
     #: the mode's residual Jacobian inverted at z (for the chord method; None:
     #: not computed)
     inverse: np.ndarray | None = None
+    #: how far (m) the finger may enter the bird before a contact is tried
+    #: (GRAZE_DEPTH after a first touch that would pull, else 0)
+    graze: float = 0.0
 
 
 class BeltedContact:
@@ -199,7 +206,7 @@ class BeltedContact:
                 # just past the crossing, where the depth, near linear in the
                 # step, passes EVENT_DEPTH / 2 (a secant from the clearance now)
                 _, kind, depth = new
-                before = self.depth(state, kind)
+                before = self.excess(state, kind)
                 h *= (-before + EVENT_DEPTH / 2) / (depth - before) if before < 0.0 else 0.5
                 continue
             h /= 2
@@ -215,21 +222,27 @@ class BeltedContact:
         ("locate", kind, depth) (a contact starts inside it, ``depth`` m deep
         at its end: shorten it to where it starts); ``base``."""
         mode, z = state.mode, state.z
+        touched = None
         for _ in range(4):
             new = self._newton(replace(at, mode=mode, z=z))
             if new is None:
                 return None
+            if new.graze > 0.0 and self.depth(new, "bird") < 0.0:
+                new = replace(new, graze=0.0)              # clear of the bird again
             event = self.event(new)
             if event is None:
                 return new
             kind, depth = event
             if kind == "base":
                 return "base"
+            if kind == "release-bird" and touched is not None:
+                return replace(touched, graze=GRAZE_DEPTH)  # a first touch that pulls
             if depth > EVENT_DEPTH and h > EVENT_STEP and kind in ("bird", "belt"):
                 return "locate", kind, depth
             switched = self.switch(new, kind)
             if switched is None:
                 return None
+            touched = new if kind == "bird" else None
             mode, z = switched.mode, switched.z
             at = replace(at, side=switched.side, inverse=None)
         return None
@@ -295,6 +308,10 @@ class BeltedContact:
         """How far (m) the finger is into the belt (``kind`` belt: its tip) or
         the bird (``bird``; the bird out of reach: -inf), < 0 clear of it."""
         raise NotImplementedError
+
+    def excess(self, state: Belted, kind: str) -> float:
+        """:meth:`depth` beyond what the state allows before a contact starts."""
+        return self.depth(state, kind) - (state.graze if kind == "bird" else 0.0)
 
     def event(self, state: Belted) -> tuple[str, float] | None:
         """The first thing wrong with a solved state and how far past its

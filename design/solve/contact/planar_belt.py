@@ -156,8 +156,8 @@ class PlanarBeltContact(BeltedContact):
                 return "release-belt", 0.0
         elif self.depth(state, "belt") > 0.0:
             return "belt", self.depth(state, "belt")
-        if mode not in BIRD_MODES and self.depth(state, "bird") > 0.0:
-            return "bird", self.depth(state, "bird")
+        if mode not in BIRD_MODES and self.excess(state, "bird") > 0.0:
+            return "bird", self.excess(state, "bird")
         return None
 
     def depth(self, state: Belted, kind: str) -> float:

@@ -141,11 +141,16 @@ class ModelCheck:
             raise RuntimeError(f"the spatial check's run {path.stem} failed: {run['error']}")
         return run
 
+    def runs(self, label: str) -> list[dict]:
+        """The spatial runs submitted as ``label`` (:func:`spatial_summary`),
+        ended early or not; a run that raised fails (RuntimeError naming it)."""
+        return [self._wait(path) for path in self._runs[label]]
+
     def summaries(self, label: str) -> list[dict]:
         """Every bird's spatial run of the design submitted as ``label``; a
         run that failed or ended early fails the check (RuntimeError naming
         it)."""
-        runs = [self._wait(path) for path in self._runs[label]]
+        runs = self.runs(label)
         for run in runs:
             if not run["ok"]:
                 raise RuntimeError(f"the spatial check of the {label} design ended early: "

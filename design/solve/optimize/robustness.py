@@ -85,22 +85,29 @@ def scenes(setup: GraspSetup) -> list[GraspSetup]:
 def table(baseline: list[dict], optimum: list[dict], cap: float) -> dict:
     """result.json's ``robustness`` from the two designs' runs of every case
     (design/solve/optimize/model_check.py's spatial_summary, in CASES
-    order): each case's holds, peaks and jams, whether the optimum beats the
-    baseline there, and the share of the cases in which it does."""
+    order): each case's holds, peaks and jams (or why a run ended early),
+    whether the optimum beats the baseline there, and the share of the
+    cases in which it does."""
     rows = []
     for (name, _), b, o in zip(CASES, baseline, optimum):
-        beats = (o["hold_time_s"] > b["hold_time_s"] and not o["jam"] and
-                 o["max_finger_force_N"] <= cap * (1 + CAP_TOLERANCE))
+        beats = (b["ok"] and o["ok"] and o["hold_time_s"] > b["hold_time_s"] and not o["jam"]
+                 and o["max_finger_force_N"] <= cap * (1 + CAP_TOLERANCE))
         rows.append({"case": name,
                      **{f"{label}_{key}": run[key] for label, run in (("baseline", b),
                                                                       ("optimum", o))
                         for key in ("hold_time_s", "max_finger_force_N",
                                     "max_finger_force_finger")},
-                     "baseline_jam": "; ".join(b["jam"]), "optimum_jam": "; ".join(o["jam"]),
+                     "baseline_jam": _trouble(b), "optimum_jam": _trouble(o),
                      "optimum_beats_baseline": bool(beats)})
     share = float(np.mean([r["optimum_beats_baseline"] for r in rows]))
     return {"cap_N": cap, "cases": rows, "share_beaten": share, "target_share": TARGET_SHARE,
             "broken_by": [r["case"] for r in rows if not r["optimum_beats_baseline"]]}
+
+
+def _trouble(run: dict) -> str:
+    """A run's jams, or that it ended early and why (a run that ended early
+    cannot be judged: the optimum does not beat the baseline there)."""
+    return "; ".join(run["jam"]) if run["ok"] else f"the run ended early: {run['message']}"
 
 
 def robustness_text(robust: dict) -> str:

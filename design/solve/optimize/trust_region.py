@@ -142,12 +142,13 @@ class Scored:
         """How far (N) the worst finger of any bird presses over its limit: the
         bird's cap (N) or the finger's fold force, whichever is lower, within
         ``tolerance`` (relative); inf where a bird is held to the end of its
-        run or not carried on (a jam no force measures)."""
+        run or not carried on (a jam no force measures), or where its
+        simulation ended early (a failed contact: nothing to judge)."""
         worst = -np.inf
         for m, cap in zip(self.members, np.broadcast_to(np.asarray(caps, float),
                                                         (len(self.members),))):
             s = m.run.summary
-            if any(not reason.startswith("finger ") for reason in s["jam"]):
+            if not s["ok"] or any(not reason.startswith("finger ") for reason in s["jam"]):
                 return np.inf
             limits = finger_limits(m.run.setup, cap)
             peaks = np.array([s["max_force_per_finger_N"][gf.name]
@@ -255,6 +256,11 @@ def optimise(space: DesignSpace | Population, cap, settings: LoopSettings,
     d0 = population.space.scale(population.space.base_values)
     with profile.phase(SIMULATIONS):
         baseline = score(population, d0, settings)
+    failed = [f"{m.name}: {e.run.summary['message']}" for m, e in
+              zip(population.members, baseline.members) if not e.run.summary["ok"]]
+    if failed:
+        raise ValueError("the baseline's simulation ended early, so no design can start from "
+                         "it: " + "; ".join(failed))
     if start is None:
         best = baseline
     else:
@@ -491,7 +497,7 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
     hold_error = abs(verified.hold - nlp_hold) / max(nlp_hold, 1e-12)
     s = verified.run.summary
     passed = hold_error <= HOLD_TOLERANCE and verified.peak <= cap * (1 + CAP_TOLERANCE) \
-        and not s["jammed"]
+        and not s["jammed"] and s["ok"]
     return {"hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
             "max_finger_force_N": verified.peak,
             "max_finger_force_finger": s["max_finger_force_finger"],
@@ -500,7 +506,8 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
             "hold_time_relative_difference": hold_error,
             "hold_tolerance": HOLD_TOLERANCE, "cap_tolerance": CAP_TOLERANCE,
             "model_warnings": validity_problems(s["validity"]),
-            "jam": s["jam"], "passed": bool(passed)}
+            "jam": s["jam"], "simulation_ok": s["ok"], "simulation_message": s["message"],
+            "passed": bool(passed)}
 
 
 def population_verdict(population: Population, claims: list, verified: Scored, caps) -> dict:
