@@ -73,13 +73,13 @@ def test_readings_within_noise_of_their_physical_bound_are_accepted_and_counted(
     as read; the warning counts the rows and gives the largest excess."""
     rows = X_ROWS + ["0.5,90,100,25,25.49,0,", "0.5,90,100,100,99.99,2,",
                      "0.5,90,100,100,,,-182.4"]
-    problem = check(_problem(tmp_path, rows, header=X_HEADER, extra=NOISY))
+    problem = check(_problem(tmp_path, rows, header=X_HEADER, extra=NOISY)).value
     note = problem.data.note
     assert note.startswith("3 row(s) read a point farther from the clamp than its arc length s")
     assert "by up to 4.9 standard deviations" in note and "lines 11, 12, 13)" in note
     x = [o.value for o in problem.data.observations if o.line == 11 and o.quantity == "x"]
     assert x == [pytest.approx(0.02549)]                      # fitted as read, not clipped
-    assert check(_problem(tmp_path, X_ROWS, header=X_HEADER, extra=NOISY)).data.note is None
+    assert check(_problem(tmp_path, X_ROWS, header=X_HEADER, extra=NOISY)).value.data.note is None
 
 
 @pytest.mark.parametrize("row, message", [
