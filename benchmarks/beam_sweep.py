@@ -1,6 +1,6 @@
 """A 1000-load beam sweep through the public API against scipy's solve_bvp.
 
-Issue 13's target: ``design.simulate`` on a beam scene whose ``F`` is a list
+The target: ``design.simulate`` on a beam scene whose ``F`` is a list
 of 1000 loads, default solver (collocation, 16 intervals of degree 4), on the
 thesis's non-uniform finger (models/fingers/thesis_nonuniform_soft.yaml), at
 least 50x faster per solve than ``scipy.integrate.solve_bvp(tol=1e-8)`` on

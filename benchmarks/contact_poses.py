@@ -9,13 +9,7 @@ the side left to the solver, alone and as one sequence of all the poses
 (each continued from the last, unrelated, one).
 
 Prints a table and writes benchmarks/results/contact_poses.json (or
-``--out``). Measured with this script on
-the solver before issue 12's item 6 (commit 52d5d8e): 36 of the 2000
-imposed-side solves ended "the contact reached the finger's base ... the
-object presses on the drum" (the object being at least 2 cm from it), and
-the sequences solved 910 (µ = 0) and 999 (µ = 0.4) of the 1000 poses; the
-poses alone, 1000 of 1000. Since: every one, and the imposed-side solves
-agree with the reference to 3.2e-7 m and 1.2e-5 in force.
+``--out``).
 
 Times, warm against warm: the solver and the reference each solve the first
 pose once before the timed loop (building their CasADi functions and

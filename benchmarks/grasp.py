@@ -8,7 +8,7 @@ and step is compared with a reference: the default adaptive integrator at
 4x finer resolution (max step / 4, tolerances / 4^4). The thesis's baseline
 is fixed-step BDF-4 with the forces frozen over each step: every row's wall
 time is given as a ratio to it, at the thesis's 5.6 ms step and at 1.4 ms
-(where it meets issue 4's accuracy targets), measured in the same run.
+(where it meets the accuracy targets), measured in the same run.
 
 Warm against warm: a first run (the default integrator over the same
 second) builds the contact solvers' CasADi functions and is reported apart
@@ -36,9 +36,9 @@ from design.tradeoff.grasp import CASES, DEFAULT
 RESULTS = Path(__file__).parent / "results" / "grasp.json"
 T_SKIP, DURATION = 0.0, 1.0
 #: the thesis's integrator at its own step, and at the step where it meets
-#: issue 4's targets (hold within 1 %, peak within 2 % of the reference)
+#: the accuracy targets (hold within 1 %, peak within 2 % of the reference)
 BASELINES = ("bdf4 (thesis) 5.6 ms", "bdf4 1.4 ms")
-#: issue 13's target for the default integrator: wall time per simulated second (s)
+#: the speed target for the default integrator: wall time per simulated second (s)
 TARGET_WALL_PER_SIMULATED_S = 0.3
 
 

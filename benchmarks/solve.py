@@ -11,7 +11,7 @@ re-simulated candidate). The simultaneous alternative, every finger stage's
 collocation unknowns as NLP variables instead of embedded rootfinders, is
 sized (not solved) for comparison.
 
-Memory (issue 13, "cost growth"): each size runs in its own fresh process
+Memory: each size runs in its own fresh process
 (multiprocessing's "spawn"), one after the other, never two at once, so its
 resident set is its own. A row records the resident set just before the NLP
 is built (after the simulations: Python, CasADi, the simulator), the peak
@@ -61,16 +61,14 @@ expected outcome here, not a converged optimum.
 
 Prints the tables and writes benchmarks/results/solve.json.
 
-Where the main job's time goes (issue 13): the whole ``design solve
+Where the main job's time goes: the whole ``design solve
 problems/hold_time.yaml`` through the public API (``design.api.solve``), its
 profile (wall time per phase, each CasADi function's evaluation time and
 calls, Ipopt's own time, peak memory: design/solve/optimize/profile.py)
 printed as a table and written to solve.json's ``main_job``, with its
 status, verified and optimiser hold, and the machine's cores and load at
-the start and end. About 1 minute on 2 cores (4-5 before the compiled
-contact functions of issue 13), on top of the sizes' 3 (9 processes of
-15-30 s each, with a warm compile cache; the sizes record their wall time
-and the load averages at their start and end too).
+the start and end; the sizes record their wall time and the load averages
+at their start and end too.
 
     python -m benchmarks.solve                  # sizes, then the main job's profile
     python -m benchmarks.solve --profile-only   # the main job's profile only

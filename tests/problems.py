@@ -60,7 +60,7 @@ def thesis_grasp_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = 
 
 
 def entering_poses(seed: int, count: int, length: float = 0.203, drum_radius: float = 0.0825):
-    """Random finger poses and objects (issue 12, item 6): semi-axes 30-100 mm
+    """Random finger poses and objects: semi-axes 30-100 mm
     by 30-80 mm at any orientation, the object clear of the drum (r > r_D
     everywhere on it), and the straight finger entering it between 20 % and
     30 % of its length. Returns [(FingerPose, world-frame Ellipse)]."""

@@ -1,4 +1,4 @@
-"""Every beam method at the extremes, each with a defined outcome (issue 2, item 5)."""
+"""Every beam method at the extremes, each with a defined outcome."""
 
 from dataclasses import replace
 
@@ -127,8 +127,8 @@ def test_exactly_axial_load_buckles_past_euler(method):
 def test_axial_load_past_euler_without_a_buckled_shape_is_not_converged(method, monkeypatch):
     """If Newton finds no buckled shape past the Euler load, the straight
     state (an unstable equilibrium there) comes back as not converged, with
-    the reason, and the uniform finger's other equilibrium is reported
-    (issue 12, item 5: it used to be marked converged, the only equilibrium)."""
+    the reason (not marked converged, as if it were the only equilibrium),
+    and the uniform finger's other equilibrium is reported."""
     cls = METHODS[method]
     solve = cls._solve
     monkeypatch.setattr(cls, "_solve", lambda self, load, guess: replace(

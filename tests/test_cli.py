@@ -105,7 +105,7 @@ COMMANDS = {"simulate": ["simulate", str(ROOT / "problems" / "beam_table_2_1.yam
 @pytest.mark.parametrize("command", list(COMMANDS))
 def test_an_output_folder_under_a_file_is_refused_before_the_run(tmp_path, capsys, nothing_runs,
                                                                   command):
-    """Issue 12, item 8: exit 2 naming the folder, before anything runs or is written."""
+    """Exit 2 naming the folder, before anything runs or is written."""
     blocker = tmp_path / "a_file"
     blocker.write_text("not a folder")
     out = blocker / "out"
@@ -151,7 +151,7 @@ def test_an_output_folder_where_no_file_can_be_made_is_refused(capsys, nothing_r
 
 
 def test_reusing_an_output_folder_leaves_only_the_new_runs_files(tmp_path, capsys):
-    """Issue 12, item 9: a contact scene run into a beam scene's folder
+    """A contact scene run into a beam scene's folder
     removes the beam's shapes.csv and figure; a file the toolkit did not
     write stays."""
     out = tmp_path / "out"
@@ -191,7 +191,7 @@ def _footer_command(report: Path) -> str:
 
 
 def test_the_report_gives_the_command_that_reruns_its_scene_file(tmp_path, monkeypatch):
-    """Issue 12, item 10: the footer names the scene file as it was given (not
+    """The footer names the scene file as it was given (not
     `<name>.yaml`, which need not exist), so the command works where the run did."""
     monkeypatch.chdir(ROOT)
     scene = tmp_path / "my scene.yaml"
@@ -225,7 +225,7 @@ def test_a_scene_given_as_content_has_no_command(tmp_path):
 
 
 def test_beam_shape_is_the_whole_finger_and_tip_is_the_load_point(tmp_path):
-    """Issue 12, item 10: `tip` is the load point (s = at); `shape` runs on to
+    """`tip` is the load point (s = at); `shape` runs on to
     the finger's free end, straight and moment-free past the load."""
     import numpy as np
     import yaml

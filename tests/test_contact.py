@@ -1,4 +1,4 @@
-"""Finger against an ellipse (issue 3): the robust solver at every situation the
+"""Finger against an ellipse: the robust solver at every situation the
 thesis's solvers could not handle, the invariants, and the thesis's algorithms
 measured as baselines."""
 
@@ -329,7 +329,7 @@ def test_sticking_contact_is_found_where_the_sliding_stops():
 def test_stick_bisection_stopped_early_is_not_converged(monkeypatch, detail):
     """No equilibrium at the bisection's midpoints: the stick is not resolved,
     and the solution (with its shape, or the brief one of trial evaluations)
-    says so instead of reporting a stick (issue 12, item 5)."""
+    says so instead of reporting a stick."""
     solver, ell, kin = sticking_scene()
     fail_continuation(monkeypatch, solver, lambda tau_mu: abs(tau_mu) < 0.6 * (1 - 1e-9))
     sol, _ = solver.solve_frame(ell, "auto", kin, None, detail=detail)
@@ -341,8 +341,8 @@ def test_failed_friction_reversal_is_not_converged(monkeypatch):
     """With friction kept at the edge of sliding (the grasp's setting), a
     finger sliding against its friction faster than the reversal speed has
     the friction reversed; if no equilibrium with the reversed friction is
-    found, the solution is not converged (it used to keep the old friction
-    and report success; issue 12, item 5)."""
+    found, the solution is not converged (not the old friction reported as
+    a success)."""
     solver, ell, kin = sticking_scene(reversal_speed=1e-5)
     sol, _ = solver.solve_frame(ell, "auto", kin, None)
     assert sol.converged and sol.friction == "baseward", sol.message

@@ -1,4 +1,4 @@
-"""The planar contact solver on random valid poses (issue 12, item 6): the
+"""The planar contact solver on random valid poses: the
 object clear of the drum, the straight finger entering it at about a quarter
 of its length, µ = 0 and 0.4. Before the fix 7 of these 400 imposed-side
 solves (4 of the 200 below) and one pose of a sequence came back "the

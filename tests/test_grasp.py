@@ -1,4 +1,4 @@
-"""The grasp of the thesis's mean bird (issue 4): accuracy against a 4x finer
+"""The grasp of the thesis's mean bird: accuracy against a 4x finer
 run, the reach filter, the thesis's stiffness finding, the legs, the
 baseline integrator. The runs start at t = 0 with the bird at Table 5-3's
 X0 = -0.075 m, where finger 4a is already under it; set b arrives 1 s later,
@@ -40,12 +40,11 @@ def hard_fine():
 
 
 def test_default_integrator_is_within_target_of_a_4x_finer_run(hard, hard_fine):
-    """Issue 4's targets: hold time within 1%, peak finger force within 2%.
-    Measured at the default 10 ms steps: 0.003 % and 0.017 % (the peak being
-    finger 5a's beyond its fold; 0.04 % and 0.02 % at 5 ms), since the
-    fingers' friction reversals are located as events and each finger's
-    maxima between the steps; with reversals decided at the accepted steps
-    (5 ms) they came 0.35 % and 1.96 % off, hence the 0.2 % bounds."""
+    """The accuracy targets: hold time within 1%, peak finger force within 2%.
+    With the fingers' friction reversals located as events and each finger's
+    maxima between the steps, the default run is an order of magnitude
+    closer than that (``python -m benchmarks.grasp``), hence the 0.2 %
+    bounds: reversals decided at the accepted steps would break them."""
     a, b = hard.summary, hard_fine.summary
     assert a["hold_time_s"] > 0.15
     assert a["hold_time_s"] == pytest.approx(b["hold_time_s"], rel=0.01)

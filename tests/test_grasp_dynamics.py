@@ -69,11 +69,11 @@ def test_landing_is_a_plastic_impact():
     dyn = BirdDynamics(FOOTBALL, Legs(), 1.16)
     _, D, d1, _ = dyn.support(0.4)
     y = np.array([0.0, D, 0.4, 0.2, -0.8, -3.0])
-    landed = dyn.land(y)
-    v_n = landed[4] - landed[5] * d1                   # vertical velocity of the lowest point
+    down = dyn.land(y)
+    v_n = down[4] - down[5] * d1                       # vertical velocity of the lowest point
     assert v_n == pytest.approx(0.0, abs=1e-14)
-    assert energy(FOOTBALL, landed, 0.0) < energy(FOOTBALL, y, 0.0)
-    assert landed[3] == y[3]                           # frictionless: X momentum kept
+    assert energy(FOOTBALL, down, 0.0) < energy(FOOTBALL, y, 0.0)
+    assert down[3] == y[3]                             # frictionless: X momentum kept
 
 
 def test_belt_braking_harder_than_friction_makes_the_bird_slip():
@@ -113,7 +113,7 @@ def test_legs_pull_a_lifted_bird_back():
 
 def test_bdf4_run_stops_when_its_newton_fails(monkeypatch):
     """The thesis's BDF-4: a step whose Newton fails ends the run, not ok,
-    saying when (issue 12, item 5: the run went on from the last iterate).
+    saying when, instead of going on from the last iterate.
     The accelerations are made non-finite past X = -0.35 m, which the bird
     riding the belt reaches during the step from t = 0.10 s."""
     grasp = bare()
@@ -135,7 +135,7 @@ def test_bdf4_run_stops_when_its_newton_fails(monkeypatch):
 
 
 def test_a_belt_that_would_pull_the_bird_down_fails_the_run(monkeypatch):
-    """N >= 0 at every recorded instant (issue 11, item 6). A finger force
+    """N >= 0 at every recorded instant. A finger force
     that jumps between the event functions' evaluation and the recorded one
     (a contact changing branch) can leave the bird in a belt mode with
     N < 0: the run stops there, not ok, naming the time and the force,

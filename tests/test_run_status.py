@@ -62,8 +62,8 @@ class NoBetterNLP:
 
 
 class IpoptEndsOnAnError:
-    """Ipopt as CasADi returns it when an evaluation threw (the status an
-    interrupted solve used to end with)."""
+    """Ipopt as CasADi returns it when an evaluation threw (as an
+    interrupted solve can end)."""
 
     def __init__(self, *args, **kwargs):
         pass

@@ -1,5 +1,5 @@
 """Bad input: one clear message per problem, naming the file, the field and the
-accepted range; exit status 2; nothing written (issue 2, item 6)."""
+accepted range; exit status 2; nothing written."""
 
 import json
 import warnings
@@ -165,7 +165,7 @@ PNG = b"\x89PNG\r\n\x1a\n\x00\x00\x00\rIHDR\x00\x00\x00\x01"
 @pytest.mark.parametrize("command", ["simulate", "solve", "tradeoff"])
 def test_a_binary_file_is_named_and_nothing_is_written(tmp_path, capsys, command):
     """A PNG renamed .yaml: exit 2, a message naming the file, no output
-    folder (issue 12, item 7), not a UnicodeDecodeError traceback."""
+    folder, not a UnicodeDecodeError traceback."""
     image = tmp_path / "picture.yaml"
     image.write_bytes(PNG)
     out = tmp_path / "out"
@@ -203,8 +203,8 @@ def test_a_binary_model_file_is_named(tmp_path, capsys):
     ("hold_time.yaml", "scene", ("scene:", "scen:")),
 ])
 def test_a_misspelt_key_is_two_problems_each_said_once(tmp_path, capsys, problem, key, typo):
-    """The unknown key and the missing one, each once, counted as 2 (issue 12,
-    item 10; a design problem without `scene` used to raise KeyError)."""
+    """The unknown key and the missing one, each once, counted as 2 (a design
+    problem without `scene` too, not a KeyError)."""
     path = tmp_path / problem
     path.write_text((ROOT / "problems" / problem).read_text().replace(*typo, 1))
     out = tmp_path / "out"

@@ -1,4 +1,4 @@
-"""Property-based tests over scene inputs (issue 12): any generated scene file
+"""Property-based tests over scene inputs: any generated scene file
 either is accepted (and would run) or is rejected with exit status 2, every
 problem printed as `error: file: ...` and nothing written; never a traceback.
 

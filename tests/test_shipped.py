@@ -1,4 +1,4 @@
-"""The shipped problems and models as a user finds them (issue 12, item 13):
+"""The shipped problems and models as a user finds them:
 bare problem names resolve from any folder, `design examples` lists them,
 and a built (non-editable) install carries them as package data."""
 

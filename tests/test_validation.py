@@ -1,4 +1,4 @@
-"""The grasp model against what the thesis observed (issue 11): the football
+"""The grasp model against what the thesis observed: the football
 experiment (§5.3, Figures 5-12 to 5-14) and the mean bird's statements
 (§5.2, Figures 5-7 and 5-9), each run as `design reproduce` runs it (spatial
 finger, 3 rod intervals). The thesis states these as readings ("around

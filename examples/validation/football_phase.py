@@ -1,4 +1,4 @@
-"""Whether the football statements that fail (issue 11) depend on the drum
+"""Whether the football statements that fail depend on the drum
 phase, which the thesis does not print: run from the repository root,
 ``.venv/bin/python examples/validation/football_phase.py [--out DIR] [--workers N]``.
 

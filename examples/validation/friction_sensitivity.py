@@ -1,5 +1,5 @@
-"""How the chapter V comparisons that still fail depend on the finger friction µ_f
-(issue 11): run from the repository root,
+"""How the chapter V comparisons that fail depend on the finger friction µ_f:
+run from the repository root,
 ``.venv/bin/python examples/validation/friction_sensitivity.py [--out DIR]``.
 
 Each row is one of ``design reproduce``'s setups (spatial finger model,
