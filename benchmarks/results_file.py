@@ -1,15 +1,20 @@
-"""Writing a benchmark's JSON result (benchmarks/results/, tracked)."""
+"""Writing a benchmark's JSON result (benchmarks/results/, tracked), stamped
+with the date it was measured (``measured_at``, UTC, read by
+benchmarks/pages.py)."""
 
 from __future__ import annotations
 
 import json
+from datetime import datetime, timezone
 from pathlib import Path
 
 from design.io.results import jsonable
 
 
 def write_results(path: Path, result: dict) -> None:
-    """Write ``result`` as indented JSON to ``path`` (its folder made) and say so."""
+    """Write ``result`` as indented JSON to ``path`` (its folder made), with
+    today's date as ``measured_at``, and say so."""
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(jsonable(result), indent=1) + "\n")
+    stamped = {"measured_at": datetime.now(timezone.utc).date().isoformat(), **result}
+    path.write_text(json.dumps(jsonable(stamped), indent=1) + "\n")
     print(f"\nwrote {path}")

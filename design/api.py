@@ -116,7 +116,15 @@ def solve(source: str | Path | Mapping, out: str | Path | None = None,
     is kept in ``out/cases.sqlite`` and ``resume`` reuses them (see
     :mod:`design.study`). Raises :class:`~design.errors.StudyError`, before
     the run, if that store holds cases and ``resume`` is false, and
-    :class:`~design.errors.ProblemFileError` for bad input (nothing written)."""
+    :class:`~design.errors.ProblemFileError` for bad input (nothing written).
+    examples/quickstart.py solves a two-variable problem in seconds; a
+    scene is refused:
+
+    >>> solve("beam_table_2_3.yaml")
+    Traceback (most recent call last):
+    ...
+    ValueError: design.solve needs a design problem (kind: design); use design.simulate for scenes
+    """
     scene = load_scene(source)
     if not isinstance(scene, DesignProblem):
         raise ValueError("design.solve needs a design problem (kind: design); "
@@ -136,7 +144,12 @@ def fit(source: str | Path | Mapping, out: str | Path | None = None,
     calibrate a finger's EI(s) or a belt's speed profile from measurements
     (with ``out``, also write the model file, result.json, the CSV tables
     and ``report.html`` there). Raises
-    :class:`~design.errors.ProblemFileError` for bad input (nothing written)."""
+    :class:`~design.errors.ProblemFileError` for bad input (nothing written).
+
+    >>> belt = fit("examples/fit/belt_figure_5_10.yaml")    # from the checkout's root
+    >>> belt.status, round(belt.to_dict()["fitted"]["final_speed"], 2)
+    (<Status.FITTED: 'fitted'>, 0.25)
+    """
     from design.report.fit import write_fit
     from design.run.fit import run as fit_run
 
