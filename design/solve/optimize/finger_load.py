@@ -181,11 +181,12 @@ class SpatialStage:
     #: constants c: grasper x, tilt, bird η, λ, γ, EI_ref, µ, ε, finger-belt µ, then
     #: widths, stiffness params
     n_fixed = 9
-    #: dense LU, as the spatial rootfinder's (spatial_equations.py: 39 % full)
+    #: dense LU, as the spatial rootfinder's (spatial_equations.py: its Jacobian is
+    #: over a third full)
     solver = "lapacklu"
     #: the stages' contacts and Jacobian blocks over this many threads (at most the
-    #: cores): hold_time_spatial.yaml 487.7 -> 385.6 s back to back on 2 cores,
-    #: nlp_g 229 -> 157 s, every iterate the same
+    #: cores): the spatial stages are costly enough to gain from a second core, and
+    #: every iterate stays the same (``python -m benchmarks.solve`` profiles nlp_g)
     threads = 2
 
     def __init__(self, gf: GraspFinger, grasper: Grasper, bird: Bird, friction: float,
