@@ -42,9 +42,19 @@ def one_blas_thread():
         yield
 
 
-@lru_cache(maxsize=1)
 def ipopt_build() -> str:
-    """Ipopt's version and linear solver as Ipopt prints them."""
+    """Ipopt's version and linear solver as Ipopt prints them ("unknown" where
+    it printed nothing)."""
+    try:
+        return _ipopt_line()
+    except LookupError:
+        return "unknown"
+
+
+@lru_cache(maxsize=1)
+def _ipopt_line() -> str:
+    """The line Ipopt's banner names itself in (LookupError, not cached, where
+    it printed none: a stand-in solver)."""
     x = ca.MX.sym("x")
     with tempfile.TemporaryDirectory() as folder:
         path = os.path.join(folder, "ipopt.out")
@@ -53,9 +63,12 @@ def ipopt_build() -> str:
                                "print_level": 0, "sb": "yes", "output_file": path,
                                "file_print_level": 5, "max_iter": 1}})
         solver(x0=1.0)
-        with open(path, encoding="utf-8", errors="replace") as f:
-            line = next((s for s in f if s.startswith("This is Ipopt")), "")
-    return line.strip().removeprefix("This is ").rstrip(".") or "unknown"
+        lines = open(path, encoding="utf-8", errors="replace").readlines() \
+            if os.path.exists(path) else []
+    line = next((s for s in lines if s.startswith("This is Ipopt")), None)
+    if line is None:
+        raise LookupError("Ipopt printed no banner")
+    return line.strip().removeprefix("This is ").rstrip(".")
 
 
 def numerics() -> dict:
