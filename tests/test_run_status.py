@@ -13,7 +13,6 @@ import pytest
 from design.cli import main
 from design.run.solve import ERROR, FAILED, NO_IMPROVEMENT, VERIFIED, overall_status
 from design.solve.optimize.transcription import DesignNLP, NLPResult
-from design.solve.reproducible import ipopt_build
 from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
 
 
@@ -92,7 +91,6 @@ def failing_nlps(how):
 def test_every_nlp_failing_is_an_error_not_a_verified_baseline(problem, monkeypatch, capsys,
                                                                 how):
     monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", failing_nlps(how))
-    ipopt_build()                  # result.json's numerics: Ipopt's own, before it is replaced
     monkeypatch.setattr("design.solve.optimize.transcription.ca.nlpsol", IpoptEndsOnAnError)
     code, result, last, stderr, report, out = solve(problem, capsys)
     assert code == 1
