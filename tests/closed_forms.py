@@ -1,7 +1,7 @@
 """Independent references for the beam and effective-EI tests: the classical
 closed form of a uniform cantilever under a transverse dead load, and a
 shooting solve of the non-uniform one, written here with scipy alone (no
-code of :mod:`design.solve`). Units: m, N, rad; base at the origin, the
+code of the toolkit's solvers). Units: m, N, rad; base at the origin, the
 unloaded finger along +x, the load F along +y at arc length a.
 
 The uniform cantilever (Bisshopp & Drucker 1945): EI ψ'' = -F cos ψ with
