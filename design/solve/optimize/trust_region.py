@@ -501,7 +501,8 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
     s = verified.run.summary
     passed = hold_error <= HOLD_TOLERANCE and verified.peak <= cap * (1 + CAP_TOLERANCE) \
         and not s["jammed"] and s["ok"]
-    return {"hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
+    return {"finger_model": s["finger_model"],
+            "hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
             "max_finger_force_N": verified.peak,
             "max_finger_force_finger": s["max_finger_force_finger"],
             "max_finger_force_time_s": s["max_finger_force_time_s"],
