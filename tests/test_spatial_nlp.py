@@ -168,3 +168,39 @@ def test_the_nlp_calls_the_spatial_finger_with_each_nodes_state(monkeypatch):
         t_phase += phase.duration
     assert n == forces.size and checked > 50
     assert forces.max() > 20.0                   # finger 4a holds the bird: real contacts
+
+
+@pytest.fixture(scope="module")
+def finger_5a_on_the_belt():
+    """Finger 5a pressing the placed mean bird while its tip rests on the belt
+    (the spatial run to 0.245 s, 3 s CPU: its last record has 5a in mode
+    interior+belt at about 17 N), with its NLP function, interpreted."""
+    from design.solve.optimize.finger_load import FingerLoad
+    space = placed_space(0.245)
+    setup = space.setup(space.scale(space.base_values))
+    run = simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)
+    i = [gf.name for gf in setup.grasper.fingers].index("5a")
+    record = run.trajectory.records[-1]
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setenv("DESIGN_COMPILE", "0")
+        load = FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
+                          setup.finger_friction, SPATIAL_NODES, 4, "spatial",
+                          setup.finger_belt_friction)
+    return load, stage_inputs(setup, record, i), record.fingers[i], record
+
+
+def test_the_nlp_finger_on_the_belt_is_the_simulators(finger_5a_on_the_belt):
+    """The same as for finger 4a, with finger 5a's tip on the belt: the NLP's
+    two-segment contact, the belt's plane and its friction law from the
+    finger's frames and the belt's speed, give the simulator's contact and
+    force to 1e-9 relative."""
+    load, inputs, state, _ = finger_5a_on_the_belt
+    mode = state.solution.extras["mode"]
+    assert mode == "interior+belt" and state.magnitude > 10.0 and state.belt_force > 0.5
+    out, force, z = load.function(mode)(*(inputs[n] for n in load.inputs))
+    z_sim = inputs["z0"]
+    assert np.abs(np.asarray(z).ravel() - z_sim).max() <= 1e-9 * np.abs(z_sim).max()
+    assert float(force) == pytest.approx(state.magnitude, rel=1e-9)
+    f, r = state.force, state.point - np.array([inputs["state"][0], 0.0, inputs["state"][1]])
+    expected = 2 * np.array([f[0], f[2], r[2] * f[0] - r[0] * f[2]])
+    assert np.allclose(np.asarray(out).ravel(), expected, rtol=1e-9, atol=1e-9 * abs(f).max())

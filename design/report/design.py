@@ -16,6 +16,12 @@ from design.solve.optimize.profile import profile_rows
 from design.solve.optimize.variables import units
 
 
+#: how the report names a finger model
+MODEL_WORDS = {"spatial": "spatial rods (bending both ways and twisting: the validated model)",
+               "planar": "the thesis's planar beams (rigid out of their bending planes)",
+               "planar-thesis": "the thesis's planar beams with its chapter III friction"}
+
+
 def verification_rows(result: dict) -> list[dict]:
     """Optimiser against the independent simulation, with each check's verdict."""
     v = result["verification"]
@@ -235,9 +241,11 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
     if result["rules_broken"]:
         page.text("Design rules broken: " + "; ".join(result["rules_broken"]))
     page.section("Verification", "verification")
+    model = v.get("finger_model", result["objective"].get("finger_model", "planar"))
     page.text(f"The optimiser's hold comes from {result['objective']['source']} on a "
               f"{result['objective']['grid_step_s'] * 1e3:g} ms grid; the independent simulation "
-              f"is the adaptive grasp simulator at 4x finer resolution.")
+              f"is the adaptive grasp simulator at 4x finer resolution. Both model the fingers "
+              f"as {MODEL_WORDS.get(model, model)}.")
     page.table(verification_rows(result), "Optimiser against the independent simulation",
                "verification-table")
     page.table(summary_rows(baseline, "baseline") + summary_rows(optimum, "optimum"),

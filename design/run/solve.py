@@ -491,8 +491,10 @@ def status_line(result: dict) -> str:
     claimed = result["objective"]["hold_time_s"]
     claimed = "not evaluated" if claimed is None or not np.isfinite(claimed) else \
         f"{claimed:.4f} s"
+    model = v.get("finger_model", "planar")
     return (f"{status}{caveat}: hold {v['hold_time_s']:.4f} s in the independent simulation "
-            f"(optimiser {claimed}; baseline {b['hold_time_s']:.4f} s), {peak}{check}")
+            f"with {model} fingers (optimiser {claimed}; baseline {b['hold_time_s']:.4f} s), "
+            f"{peak}{check}")
 
 
 def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: Scored,
@@ -512,7 +514,8 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: S
         "design": {v["name"]: v["optimum"] for v in variables},
         "variables": variables,
         "objective": {"hold_time_s": claimed, "source": source,
-                      "grid_step_s": problem.settings.nlp.time_step},
+                      "grid_step_s": problem.settings.nlp.time_step,
+                      "finger_model": space.baseline.finger_model},
         "verification": check,
         "cap": {"N": caps_value(outcome.caps), "given_as": cap_spec.describe()},
         "rules_broken": [tag for margin, tag in rule_margins(space.values(np.asarray(d, float)),

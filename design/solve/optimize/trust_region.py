@@ -227,9 +227,11 @@ def score(population: Population, d: np.ndarray, settings: LoopSettings,
 
 def better(a: Scored, b: Scored, caps) -> bool:
     """Is a better than b: feasible (every bird under its cap, every finger
-    under its fold force, no jam) beats infeasible, then the longer hold;
+    under its fold force, no jam; within the verification's CAP_TOLERANCE,
+    so that a baseline whose own peak is the cap is not judged by its
+    rounding) beats infeasible, then the longer hold by more than 10 µs;
     among infeasible designs the smaller largest excess over a limit."""
-    fa, fb = a.within(caps), b.within(caps)
+    fa, fb = a.within(caps, CAP_TOLERANCE), b.within(caps, CAP_TOLERANCE)
     if fa != fb:
         return fa
     if fa:
@@ -317,7 +319,8 @@ def optimise(space: DesignSpace | Population, cap, settings: LoopSettings,
             "iteration": it + 1, "radius": radius, "nlp_cap_N": caps_value(cap_nlp),
             "ipopt_status": result.status, "ipopt_iterations": result.iterations,
             "nlp_wall_time_s": result.wall_time, "nlp_hold_time_s": result.hold_time,
-            "nlp_peak_force_N": result.peak_force, "simulated_hold_time_s": candidate.hold,
+            "nlp_peak_force_N": result.peak_force, "candidate_scaled": result.d.tolist(),
+            "simulated_hold_time_s": candidate.hold,
             "simulated_peak_force_N": candidate.peak, "accepted": accepted,
             "grid_reproduces_simulation": reproduced, "view_error": view_error,
             "view": None if view is None else {
@@ -498,7 +501,8 @@ def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:
     s = verified.run.summary
     passed = hold_error <= HOLD_TOLERANCE and verified.peak <= cap * (1 + CAP_TOLERANCE) \
         and not s["jammed"] and s["ok"]
-    return {"hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
+    return {"finger_model": s["finger_model"],
+            "hold_time_s": verified.hold, "hold_windows": s["hold_windows"],
             "max_finger_force_N": verified.peak,
             "max_finger_force_finger": s["max_finger_force_finger"],
             "max_finger_force_time_s": s["max_finger_force_time_s"],
