@@ -315,3 +315,23 @@ def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path,
     html = (tmp_path / "report.html").read_text()
     assert 'class="banner failed"' in html and "CaseFailed: did not converge: fdm" in html
     assert "could not compute" in capsys.readouterr().out
+
+
+def test_a_failed_grasp_run_is_reported_beside_the_rows_of_the_others(monkeypatch):
+    """A chapter V run that fails fails the reproduction (exit status 1) but
+    not its chapter: the rows and tables of the runs that finished are still
+    reported, and the failure names the run."""
+    from design.reproduce import beam_rows, command, contact_rows, grasp_rows
+    from design.reproduce.rows import Section
+
+    kept = Section("grasp", grasp_rows.TITLE, "text", [claim("c", "q", "t", "o", True, "why")])
+    monkeypatch.setattr(beam_rows, "compute", lambda: None)
+    monkeypatch.setattr(beam_rows, "sections", lambda _: [])
+    monkeypatch.setattr(contact_rows, "compute", lambda: None)
+    monkeypatch.setattr(contact_rows, "sections", lambda _: [])
+    monkeypatch.setattr(grasp_rows, "compute", lambda progress: {})
+    monkeypatch.setattr(grasp_rows, "sections", lambda runs: [kept])
+    monkeypatch.setattr(grasp_rows, "failures", lambda runs: ["grasp run 'x' failed: stalled"])
+    sections, failures = command.compute_sections(False)
+    assert sections == [kept]
+    assert len(failures) == 1 and "grasp run 'x' failed: stalled" in failures[0]

@@ -18,7 +18,7 @@ from design import __version__
 from design.io.results import csv_text, json_text
 from design.report.page import Page, write_report
 from design.reproduce import beam_rows, contact_rows, grasp_rows
-from design.reproduce.rows import COLUMNS, Section, tally, tally_by_basis, verdict
+from design.reproduce.rows import COLUMNS, CaseFailed, Section, tally, tally_by_basis, verdict
 
 HOW_TO_READ = (
     "Each row sets a number or a claim of the thesis beside ours. A numeric row agrees when "
@@ -49,9 +49,19 @@ def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
     ]
     if not quick:
         chapters.append((f"chapter V: grasp figures ({len(grasp_rows.setups())} runs, most with "
-                         "the spatial finger model)",
-                         lambda progress: grasp_rows.sections(grasp_rows.compute(progress))))
+                         "the spatial finger model)", _grasp_sections))
     return chapters
+
+
+def _grasp_sections(progress) -> list[Section]:
+    """Chapter V's section; raises CaseFailed after building it if a run failed
+    (its rows say which)."""
+    runs = grasp_rows.compute(progress)
+    built = grasp_rows.sections(runs)
+    failed = grasp_rows.failures(runs)
+    if failed:
+        raise CaseFailed("; ".join(failed), built)
+    return built
 
 
 def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[str]]:
@@ -63,6 +73,9 @@ def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[st
             progress(f"{name} ...")
         try:
             sections += build(progress)
+        except CaseFailed as exc:  # some cases failed: the rest is reported
+            sections += exc.sections
+            failures.append(f"{name}: could not be computed: {type(exc).__name__}: {exc}")
         except Exception as exc:  # noqa: BLE001  (any solver error: report it, go on)
             failures.append(f"{name}: could not be computed: {type(exc).__name__}: {exc}")
         if progress:

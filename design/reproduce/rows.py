@@ -34,7 +34,12 @@ CONTEXT = "context"
 
 
 class CaseFailed(RuntimeError):
-    """A reference case whose solution did not converge or finish."""
+    """A reference case whose solution did not converge or finish; ``sections``
+    holds what could be built without it."""
+
+    def __init__(self, message: str, sections: list | None = None):
+        super().__init__(message)
+        self.sections = sections or []
 
 
 @dataclass(frozen=True)
