@@ -17,6 +17,7 @@ number (a reading "of the order of", "around": 30 %). SI: m, N, s, rad.
 from __future__ import annotations
 
 from dataclasses import replace
+from functools import partial
 
 import numpy as np
 
@@ -25,7 +26,7 @@ from design.physics.kinematics import rot_y
 from design.reproduce.figures import finger_force_x_figure, path_figure, transverse_figure
 from design.reproduce.grasp import (SIZES_START, football_setup, mean_bird_setup, simulate_all,
                                     sizes_setup, slotted)
-from design.reproduce.rows import (THESIS_MEASUREMENT, CaseFailed, Row, Section, claim, compare,
+from design.reproduce.rows import (THESIS_MEASUREMENT, Row, Section, claim, compare,
                                    context)
 from design.solve.grasp.simulation import GraspRun
 from design.solve.grasp.validity import validity_problems
@@ -128,18 +129,24 @@ def setups() -> dict:
 
 
 def compute(progress=None) -> dict[str, GraspRun]:
-    """Every chapter V run, by name; raises CaseFailed if one did not finish
-    (other than by its wall-time budget)."""
+    """Every chapter V run, by name, finished or not (:func:`failures`)."""
     every = setups()
     spread = {spread_name(t, p) for t in SPREAD_TILTS for p in SPREAD_PHASES} - {FOOTBALL}
     runs = simulate_all({k: v for k, v in every.items() if k not in spread}, progress, RUN_BUDGET)
     runs.update(simulate_all({k: every[k] for k in every if k in spread}, progress,
                              SPREAD_BUDGET))
-    failed = [f"{k} ({r.summary['message']})" for k, r in runs.items()
-              if not r.trajectory.ok and not r.trajectory.out_of_time]
-    if failed:
-        raise CaseFailed(f"grasp runs did not finish: {'; '.join(failed)}")
     return runs
+
+
+def stopped(run: GraspRun) -> bool:
+    """Whether the run ended before its duration: failed, or stopped by its budget."""
+    return not run.trajectory.ok
+
+
+def failures(runs: dict[str, GraspRun]) -> list[str]:
+    """The runs that failed (not those their wall-time budget stopped), in words."""
+    return [f"grasp run '{k}' failed: {r.summary['message']}" for k, r in runs.items()
+            if not r.trajectory.ok and not r.trajectory.out_of_time]
 
 
 def _series(run: GraspRun, index: int) -> np.ndarray:
@@ -273,96 +280,117 @@ def _peak(run: GraspRun) -> str:
 
 
 def mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
-    return unfinished(_mean_bird_rows, runs,
-                      [HARD, SOFT, CONSTANT, PLANAR_HARD, PLANAR_SOFT, SOFT_PLACED,
-                       CONSTANT_PLACED, SOFT_FRICTIONLESS, THESIS_SOFT, THESIS_HARD,
-                       THESIS_CONSTANT],
-                      "Figure 5-7, mean bird (Table 5-3)", "fingers and forces",
-                      "fingers 1, 2, 4, 5; finger 4 about 11 N")
-
-
-def _mean_bird_rows(runs: dict[str, GraspRun]) -> list[Row]:
+    """Figures 5-7 and 5-9's mean bird, each group of rows computed only from
+    runs that finished."""
     case = "Figure 5-7, mean bird (Table 5-3)"
-    rows = []
+    thesis = "fingers 1, 2, 4, 5; finger 4 about 11 N"
     # Figure 5-7's caption and legend compare soft (EI2) with hard (EI3) lower
     # fingers; Figure 5-6's captions number a constant-EI case 3: all three
+    rows = []
     for name, label in ((SOFT, "soft lower fingers (case 2)"), (HARD, "hard lower fingers"),
                         (CONSTANT, "constant EI")):
-        run = runs[name]
-        s = run.summary
-        rows += [
-            claim(case, f"fingers touching the bird, {label}", "1, 2, 4, 5 ('no contact "
-                  "between finger #3 and the bird')", touching(run),
-                  touching(run) == "1, 2, 4, 5", "Criterion: the same fingers."),
-            claim(case, f"finger with the peak force, {label}", "finger 4",
-                  f"finger {peak_family(run)}", peak_family(run) == "4",
-                  f"Ours: {_peak(run)}. Criterion: the same finger."),
-            compare(case, f"peak finger force, {label}", "N", PEAK_MEAN, s["max_finger_force_N"],
-                    READING_REL * PEAK_MEAN, "'In the order of 11N' (two sides x 11 N is about "
-                    f"the bird's 17.7 N weight); tolerance 30 % for a reading. Ours: "
-                    f"{peak_split(run)}." + (sweep_friction(runs[SOFT_FRICTIONLESS])
-                                             if name == SOFT else "")),
-            claim(case, f"share of the finger force-time integral while |X| <= 38.1 mm, {label}",
-                  "most ('concentrate densely' from -1.5 to +1.5 in)",
-                  impulse_share(run, lambda r: abs(r.y[0]) <= DENSE),
-                  impulse_share(run, lambda r: abs(r.y[0]) <= DENSE) > 0.5,
-                  "Criterion: more than half.", "1"),
-        ]
+        needs = [name, SOFT_FRICTIONLESS] if name == SOFT else [name]
+        rows += unfinished(partial(_figure_5_7_rows, name=name, label=label), runs, needs, case,
+                           f"fingers and forces, {label}", thesis)
     for name, label in ((SOFT_PLACED, "soft lower fingers (case 2)"),
                         (CONSTANT_PLACED, "constant EI")):
-        run = runs[name]
-        share = impulse_share(run, lambda r: abs(r.y[0]) <= DENSE)
-        rows.append(claim(
-            case, f"Table 5-3's start as printed, the bird placed on finger 4a at t = 0, {label}",
-            "fingers 1, 2, 4, 5 touch; the peak is finger 4's, about 11 N; forces concentrate "
-            "within ±1.5 in", f"fingers {touching(run)}; {_peak(run)}; {share:.0%} of the "
-            f"force-time integral within ±1.5 in",
-            meets_figure_5_7(run) and share > 0.5,
-            "The runs above let the bird arrive (one set period upstream); this one starts it "
-            "where Table 5-3 prints, already held by finger 4a, as the thesis's 0.5 s run "
-            "(Figure 5-5) seems to. Criterion: all three statements."))
-    hard, soft = runs[HARD].summary, runs[SOFT].summary
-    rows.append(claim("Figure 5-9, mean bird", "longest N = 0 window, hard minus soft lower "
-                      "fingers", "> 0 (hard fingers hold longer)",
-                      hard["hold_time_s"] - soft["hold_time_s"],
-                      hard["hold_time_s"] > soft["hold_time_s"],
-                      f"Ours: {hard['hold_time_s']:.3f} s against {soft['hold_time_s']:.3f} s "
-                      f"(peaks {_peak(runs[HARD])}, {_peak(runs[SOFT])}).", "s"))
+        rows += unfinished(partial(_placed_row, name=name, label=label), runs, [name], case,
+                           f"Table 5-3's start as printed, {label}", thesis)
+    rows += unfinished(_figure_5_9_row, runs, [HARD, SOFT], "Figure 5-9, mean bird",
+                       "longest N = 0 window, hard minus soft lower fingers", "> 0")
     for name in (PLANAR_SOFT, PLANAR_HARD):
-        run = runs[name]
-        problems = validity_problems(run.summary["validity"])
-        rows.append(claim(case, f"the planar finger model on the same run ({name})",
-                          "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
-                          f"fingers {touching(run)}; {_peak(run)}",
-                          meets_figure_5_7(run),
-                          "Outside its validity: " + ("; ".join(problems) or "none") +
-                          ". Criterion: both statements."))
+        rows += unfinished(partial(_planar_row, name=name), runs, [name], case,
+                           f"the planar finger model ({name})", thesis)
     for name in (THESIS_SOFT, THESIS_CONSTANT, THESIS_HARD):
-        run = runs[name]
-        rows.append(claim(
-            case, f"the thesis's own model: planar fingers with its chapter III friction "
-            f"convention ({name.removesuffix(OWN)})",
-            "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
-            f"fingers {touching(run)}; {_peak(run)}",
-            meets_figure_5_7(run),
-            "Friction on each finger at µ, pointing tipwards whatever the sliding (as in "
-            "Tables 3-2 to 3-5; its FEM, Table 3-6, follows the sliding instead): how the "
-            "thesis computed its forces, not what our grasp runs use. Criterion: both "
-            "statements."))
+        rows += unfinished(partial(_own_model_row, name=name), runs, [name], case,
+                           f"the thesis's own model ({name})", thesis)
     return rows
+
+
+def _figure_5_7_rows(runs: dict[str, GraspRun], name: str, label: str) -> list[Row]:
+    """Figure 5-7's statements on one arriving mean-bird run."""
+    case = "Figure 5-7, mean bird (Table 5-3)"
+    run = runs[name]
+    s = run.summary
+    share = impulse_share(run, lambda r: abs(r.y[0]) <= DENSE)
+    return [
+        claim(case, f"fingers touching the bird, {label}", "1, 2, 4, 5 ('no contact "
+              "between finger #3 and the bird')", touching(run),
+              touching(run) == "1, 2, 4, 5", "Criterion: the same fingers."),
+        claim(case, f"finger with the peak force, {label}", "finger 4",
+              f"finger {peak_family(run)}", peak_family(run) == "4",
+              f"Ours: {_peak(run)}. Criterion: the same finger."),
+        compare(case, f"peak finger force, {label}", "N", PEAK_MEAN, s["max_finger_force_N"],
+                READING_REL * PEAK_MEAN, "'In the order of 11N' (two sides x 11 N is about "
+                f"the bird's 17.7 N weight); tolerance 30 % for a reading. Ours: "
+                f"{peak_split(run)}." + (sweep_friction(runs[SOFT_FRICTIONLESS])
+                                         if name == SOFT else "")),
+        claim(case, f"share of the finger force-time integral while |X| <= 38.1 mm, {label}",
+              "most ('concentrate densely' from -1.5 to +1.5 in)", share, share > 0.5,
+              "Criterion: more than half.", "1")]
+
+
+def _placed_row(runs: dict[str, GraspRun], name: str, label: str) -> list[Row]:
+    """Figure 5-7's statements with the bird placed on finger 4a at t = 0."""
+    run = runs[name]
+    share = impulse_share(run, lambda r: abs(r.y[0]) <= DENSE)
+    return [claim(
+        "Figure 5-7, mean bird (Table 5-3)", f"Table 5-3's start as printed, the bird placed on "
+        f"finger 4a at t = 0, {label}", "fingers 1, 2, 4, 5 touch; the peak is finger 4's, "
+        "about 11 N; forces concentrate within ±1.5 in", f"fingers {touching(run)}; "
+        f"{_peak(run)}; {share:.0%} of the force-time integral within ±1.5 in",
+        meets_figure_5_7(run) and share > 0.5,
+        "The runs above let the bird arrive (one set period upstream); this one starts it "
+        "where Table 5-3 prints, already held by finger 4a, as the thesis's 0.5 s run "
+        "(Figure 5-5) seems to. Criterion: all three statements.")]
+
+
+def _figure_5_9_row(runs: dict[str, GraspRun]) -> list[Row]:
+    """Figure 5-9: hard lower fingers hold the mean bird longer than soft ones."""
+    hard, soft = runs[HARD].summary, runs[SOFT].summary
+    return [claim("Figure 5-9, mean bird", "longest N = 0 window, hard minus soft lower "
+                  "fingers", "> 0 (hard fingers hold longer)",
+                  hard["hold_time_s"] - soft["hold_time_s"],
+                  hard["hold_time_s"] > soft["hold_time_s"],
+                  f"Ours: {hard['hold_time_s']:.3f} s against {soft['hold_time_s']:.3f} s "
+                  f"(peaks {_peak(runs[HARD])}, {_peak(runs[SOFT])}).", "s")]
+
+
+def _planar_row(runs: dict[str, GraspRun], name: str) -> list[Row]:
+    """The planar finger model on the arriving mean bird, with its validity."""
+    run = runs[name]
+    problems = validity_problems(run.summary["validity"])
+    return [claim("Figure 5-7, mean bird (Table 5-3)", f"the planar finger model on the same "
+                  f"run ({name})", "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
+                  f"fingers {touching(run)}; {_peak(run)}", meets_figure_5_7(run),
+                  "Outside its validity: " + ("; ".join(problems) or "none") +
+                  ". Criterion: both statements.")]
+
+
+def _own_model_row(runs: dict[str, GraspRun], name: str) -> list[Row]:
+    """The thesis's own model (``planar-thesis``) on the arriving mean bird."""
+    run = runs[name]
+    return [claim(
+        "Figure 5-7, mean bird (Table 5-3)", f"the thesis's own model: planar fingers with its "
+        f"chapter III friction convention ({name.removesuffix(OWN)})",
+        "fingers 1, 2, 4, 5 touch; peak about 11 N at finger 4",
+        f"fingers {touching(run)}; {_peak(run)}", meets_figure_5_7(run),
+        "Friction on each finger at µ, pointing tipwards whatever the sliding (as in "
+        "Tables 3-2 to 3-5; its FEM, Table 3-6, follows the sliding instead): how the "
+        "thesis computed its forces, not what our grasp runs use. Criterion: both "
+        "statements.")]
 
 
 def unfinished(rows_of, runs: dict[str, GraspRun], names: list[str], case: str, quantity: str,
                thesis: str) -> list[Row]:
     """``rows_of(runs)`` if every named run finished, else one row saying which
-    did not, with where the others went."""
-    late = [f"{n}: {runs[n].summary['message']}" for n in names
-            if runs[n].trajectory.out_of_time]
+    did not (failed, or not within RUN_BUDGET s), with where the others went."""
+    late = [f"{n}: {runs[n].summary['message']}" for n in names if stopped(runs[n])]
     if not late:
         return rows_of(runs)
-    done = [f"{n}: {_motion(runs[n])}" for n in names if not runs[n].trajectory.out_of_time]
+    done = [f"{n}: {_motion(runs[n])}" for n in names if not stopped(runs[n])]
     return [claim(case, quantity, thesis, "not finished", False,
-                  f"Not computed within {RUN_BUDGET:g} s per run: " + "; ".join(late) + "."
+                  "Not computed: " + "; ".join(late) + "."
                   + (" Finished: " + "; ".join(done) + "." if done else ""))]
 
 
@@ -573,16 +601,17 @@ def sizes_table(runs: dict[str, GraspRun]) -> list[dict]:
 
 def _run_facts(run: GraspRun) -> dict:
     """A run in one table row: fingers, peak, hold, rise, release, passing, jam,
-    and whether it finished (a run its wall-time budget stopped: as far as it got)."""
+    and whether it finished (a run that failed or that its wall-time budget
+    stopped: as far as it got)."""
     s = run.summary
     end = run.trajectory.records[-1].t
     return {"fingers_touching": touching(run), "peak_force_N": s["max_finger_force_N"],
             "peak_finger": s["max_finger_force_finger"], "hold_time_s": s["hold_time_s"],
             "centre_rise_m": s["centre_rise_m"], "released": _released(run),
-            "passes": None if run.trajectory.out_of_time else passes(run),
+            "passes": None if stopped(run) else passes(run),
             "fingers_on_belt": ", ".join(s["belt_contacts"]) or "none", "jam": _jam(run),
-            "run": f"stopped by its budget at {end:.3f} s" if run.trajectory.out_of_time
-            else "finished"}
+            "run": "finished" if not stopped(run) else f"stopped by its budget at {end:.3f} s"
+            if run.trajectory.out_of_time else f"failed at {end:.3f} s: {s['message']}"}
 
 
 def _released(run: GraspRun) -> str:
