@@ -119,7 +119,8 @@ def main(argv: list[str] | None = None) -> int:
                   f"{exp['peak_finger']} {exp['peak_force_N']:5.1f}  passes "
                   + " ".join(f"{r['case']}:{'y' if r['passes'] else 'n'}" for r in at)
                   + f"  met: {', '.join(k for k, v in met.items() if v) or 'none'}")
-        every = [p for p in PHASES if all(verdicts[f"{model} {p}"].values())]
+        every = [p for p in PHASES if verdicts[f"{model} {p}"]
+                 and all(verdicts[f"{model} {p}"].values())]
         print(f"{model}: phases meeting every statement: {every or 'none'}")
     write_rows(args.out / "football_phase.json", rows, time.perf_counter() - start,
                statements=verdicts)
