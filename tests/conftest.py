@@ -54,8 +54,9 @@ def _prefetch_jobs(session) -> list:
     from tests.test_reproduce_command import QUICK, reproduce_quick
     from tests.test_spatial_nlp import PLACED_HOLD, placed_hold
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
-    from tests.test_validation import (FOOTBALL, MEAN_HARD, MEAN_SOFT, football_run,
-                                       mean_bird_run)
+    from tests.test_validation import (FOOTBALL, MEAN_CONSTANT, MEAN_HARD, MEAN_SOFT,
+                                       PLACED_HARD, THESIS_SOFT, football_run, mean_bird_run,
+                                       placed_run)
 
     def asked(users: list[str]) -> bool:
         return any(item.nodeid.startswith(tuple(users)) for item in session.items)
@@ -100,6 +101,12 @@ def _prefetch_jobs(session) -> list:
         jobs.append((MEAN_SOFT, mean_bird_run, ("soft",), ()))
     if fixture_used("mean_hard"):
         jobs.append((MEAN_HARD, mean_bird_run, ("hard",), ()))
+    if fixture_used("mean_constant"):
+        jobs.append((MEAN_CONSTANT, mean_bird_run, ("constant",), ()))
+    if fixture_used("thesis_soft"):
+        jobs.append((THESIS_SOFT, mean_bird_run, ("soft", "planar-thesis"), ()))
+    if fixture_used("placed_hard"):
+        jobs.append((PLACED_HARD, placed_run, (), ()))
     return jobs
 
 

@@ -20,7 +20,7 @@ from design.report.page import number
 from design.reproduce.contact import CASES, THESIS_PASS, UNIFORM, pass_position, scene
 from design.reproduce.contact_rows import FEM_REL, FORCE_REL, POINT_TOL
 from design.reproduce.rows import (BASES, COLUMNS, THESIS_MEASUREMENT, claim, compare,
-                                   tally_by_basis, verdict)
+                                   context, tally, tally_by_basis, verdict)
 from tests import prefetch
 from tests.closed_forms import EFFECTIVE_EI_REL, effective_ei, transverse_cantilever
 from tests.contact_reference import reference
@@ -146,17 +146,19 @@ def test_table_5_2_effective_ei(result):
     assert hard["ours"] / soft["ours"] == pytest.approx(9.07 / 4.8, rel=1e-6)
     table = [r for r in result["rows"] if r["case"] == "Table 5-2"]
     assert len(table) == 12 and all(r["tolerance"] == 5e-5 for r in table)
-    assert all(r["basis"] == "thesis number" for r in table)
+    assert all(r["basis"] == "thesis simulation" and r["kind"] == "number" for r in table)
 
 
 def test_rows_name_their_basis_and_the_counts_split_by_it(result):
     """Table 2-1's numbers are our closed form (the thesis prints none): own
-    reference; every other row is a thesis number, statement or measurement."""
+    reference; every other row of chapters II and III compares with the
+    thesis's own calculations: thesis simulation."""
     assert {r["basis"] for r in result["rows"]} <= set(BASES)
     for r in result["rows"]:
         own = r["case"] == "Table 2-1" and r["quantity"].startswith("load-point deflection y, ") \
             and "small-deflection" not in r["quantity"]
-        assert (r["basis"] == "own reference") == own, r
+        assert r["basis"] == ("own reference" if own else "thesis simulation"), r
+    assert result["context_rows"] == 0
     by_basis = result["by_basis"]
     assert sum(v["total"] for v in by_basis.values()) == result["total"]
     assert sum(v["agree"] for v in by_basis.values()) == result["agree"]
@@ -274,16 +276,22 @@ def test_row_tolerance_and_claims():
     assert c.difference is None and not c.agrees and c.as_dict()["ours"] == 3.0
 
 
-def test_the_verdict_counts_each_basis_apart():
-    """What the thesis measured is counted apart from what it calculated, so
-    that the report says how the model fares against the experiment."""
+def test_the_verdict_counts_each_basis_apart_and_never_a_context_row():
+    """What the thesis measured is counted apart from what it simulated, so
+    that the report says how the model fares against the experiment; a
+    context row (a substitute quantity) is shown and never counted, even
+    when it would agree."""
     rows = [compare("c", "q", "m", 1.0, 1.0, 0.1, basis=THESIS_MEASUREMENT),
             claim("c", "q", "passes", "passes", True, "why", basis=THESIS_MEASUREMENT),
-            compare("c", "q", "m", 1.0, 2.0, 0.1), claim("c", "q", "more", "less", False, "why")]
-    assert tally_by_basis(rows) == {"thesis number": (0, 1), "thesis statement": (0, 1),
-                                    "thesis measurement": (2, 2)}
-    assert verdict(rows) == ("2 of 4 rows agree within their stated tolerance (thesis numbers: "
-                             "0 of 1; thesis statements: 0 of 1; thesis measurements: 2 of 2)")
+            compare("c", "q", "m", 1.0, 2.0, 0.1), claim("c", "q", "more", "less", False, "why"),
+            context("c", "q", 8.5, 8.5, "a substitute", "N")]
+    assert tally_by_basis(rows) == {"thesis measurement": (2, 2), "thesis simulation": (0, 2)}
+    assert tally(rows) == (2, 4)
+    assert [r.kind for r in rows] == ["number", "statement", "number", "statement", "number"]
+    assert rows[-1].agrees is None and rows[-1].difference == 0.0
+    assert verdict(rows) == ("2 of 4 rows agree within their stated tolerance (thesis "
+                             "measurements: 2 of 2; thesis simulations: 0 of 2); 1 context row "
+                             "shown, not counted")
 
 
 def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path, monkeypatch,
@@ -308,3 +316,23 @@ def test_a_case_that_cannot_be_computed_is_reported_with_exit_status_1(tmp_path,
     html = (tmp_path / "report.html").read_text()
     assert 'class="banner failed"' in html and "CaseFailed: did not converge: fdm" in html
     assert "could not compute" in capsys.readouterr().out
+
+
+def test_a_failed_grasp_run_is_reported_beside_the_rows_of_the_others(monkeypatch):
+    """A chapter V run that fails fails the reproduction (exit status 1) but
+    not its chapter: the rows and tables of the runs that finished are still
+    reported, and the failure names the run."""
+    from design.reproduce import beam_rows, contact_rows, grasp_rows, report
+    from design.reproduce.rows import Section
+
+    kept = Section("grasp", grasp_rows.TITLE, "text", [claim("c", "q", "t", "o", True, "why")])
+    monkeypatch.setattr(beam_rows, "compute", lambda: None)
+    monkeypatch.setattr(beam_rows, "sections", lambda _: [])
+    monkeypatch.setattr(contact_rows, "compute", lambda: None)
+    monkeypatch.setattr(contact_rows, "sections", lambda _: [])
+    monkeypatch.setattr(grasp_rows, "compute", lambda progress: {})
+    monkeypatch.setattr(grasp_rows, "sections", lambda runs: [kept])
+    monkeypatch.setattr(grasp_rows, "failures", lambda runs: ["grasp run 'x' failed: stalled"])
+    sections, failures = report.compute_sections(False)
+    assert sections == [kept]
+    assert len(failures) == 1 and "grasp run 'x' failed: stalled" in failures[0]

@@ -12,7 +12,7 @@ from design.io.fingers import read_finger
 from design.io.grasp_scene import GraspSettings, read_bird, read_conveyor, read_grasper
 from design.io.reader import Reader
 from design.physics.bird import Conveyor, Legs, belt_motion
-from design.physics.clearance import clearance, matching_tilt
+from design.physics.belt import Belt
 from design.solve.grasp.simulation import SPATIAL_NODES, GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
@@ -67,15 +67,30 @@ def belt_arrival(conveyor: Conveyor, x0: float, x1: float) -> float:
                   (x1 - x0) / conveyor.final_speed + 1.0, xtol=1e-12)
 
 
-def designed_phase(setup: GraspSetup) -> GraspSetup:
-    """The setup with the drums turned back so that the belt brings the bird
-    to Table 5-3's X0 = -0.075 m just as every finger reaches its Table 5-1
-    angle: the phase of the thesis's mean-bird run, the grasper's timing as
-    designed. The thesis prints no drum phase for starts further upstream
-    (Tables 5-4, 5-5); read literally (Table 5-1's angles at their own t = 0)
-    the bird arrives between two finger sets."""
-    t1 = belt_arrival(setup.conveyor, setup.start_x, MEAN_START)
+def designed_phase(setup: GraspSetup, start: float | None = None) -> GraspSetup:
+    """The setup with the drums turned back so that a bird riding the belt
+    from ``start`` (m; default the setup's own start) reaches Table 5-3's
+    X0 = -0.075 m just as every finger reaches its Table 5-1 angle: the phase
+    of the thesis's mean-bird run, the grasper's timing as designed. The
+    thesis prints no drum phase for starts further upstream (Tables 5-4,
+    5-5); read literally (Table 5-1's angles at their own t = 0) the bird
+    arrives between two finger sets."""
+    x0 = setup.start_x if start is None else start
+    t1 = belt_arrival(setup.conveyor, x0, MEAN_START)
     return replace(setup, grasper=advanced(setup.grasper, -t1, setup.drum_speed))
+
+
+def turned(setup: GraspSetup, degrees: float) -> GraspSetup:
+    """The setup with the drums turned on by ``degrees`` (every finger that
+    much further along its sweep at t = 0)."""
+    return replace(setup, grasper=advanced(setup.grasper, np.radians(degrees) / setup.drum_speed,
+                                           setup.drum_speed))
+
+
+def slotted(setup: GraspSetup) -> GraspSetup:
+    """The setup on a slotted pallet: every set's finger 5 passes through
+    slots cut for it (the thesis prints no pallet; the default belt is solid)."""
+    return replace(setup, belt=Belt(slots=frozenset({"5"})))
 
 
 def thesis_setup(t_skip: float = 0.0, duration: float = 2.0, lower: str = "hard",
@@ -123,52 +138,32 @@ def mean_bird_setup(lower: str = "soft", model: str = VALIDATION_MODEL,
     return s
 
 
-def upper_tilt(grasper, bird, reference, speed: float = OMEGA) -> dict[str, float]:
-    """φy (rad) of fingers 1 and 2 at which they clear ``bird`` at rest by
-    what Table 5-1's tilt leaves ``reference`` (the mean bird): 5.2 mm in
-    the transverse section (design/physics/clearance.py).
-
-    §5.1: fingers 1 and 2 restrain the bird from above, and their tilt is
-    tuned to the birds' size (Figure 5-3 draws it in that section). Table
-    5-1's -15° is the mean bird's; the football (66 mm high, not 57) would be
-    cut 11.8 mm deep by it. The thesis prints no football layout, and its
-    figures depart from Table 5-1 elsewhere (finger 3 at φx = 60° in Figures
-    5-16 to 5-18, finger 2 drawn at φy = -10° in Figure 5-4)."""
-    drum = grasper.drum(speed)
-    out = {}
-    for name in ("1", "2"):
-        gf = next(f for f in grasper.fingers if f.design_name == name)
-        target = clearance(drum, gf.mount, gf.finger.length, reference.lam, reference.gamma)
-        out[name] = matching_tilt(drum, gf.mount, gf.finger.length, target, bird.lam,
-                                  bird.gamma)
-    return out
-
-
 def football_setup(start: float = FOOTBALL_START, friction: float = 1.16,
                    phi_x3: float = 60.0, model: str = VALIDATION_MODEL,
-                   phased: bool = True, tilted: bool = True) -> GraspSetup:
-    """The Table 5-4 football on the Figure 5-10 belt from ``start`` (m): finger
-    3 at φx = ``phi_x3`` (Figures 5-16 to 5-18 use 60°), no legs; fingers 1
-    and 2 tilted to the football (:func:`upper_tilt`) unless ``tilted`` is
-    false (Table 5-1's -15°); the drums in :func:`designed_phase` unless
-    ``phased`` is false (Table 5-1's angles at t = 0)."""
+                   upper_tilt: float | None = None, phase: float = 0.0) -> GraspSetup:
+    """The Table 5-4 football on the Figure 5-10 belt from ``start`` (m): the
+    Table 5-1 grasper with finger 3 at φx = ``phi_x3`` (Figures 5-16 to 5-18
+    use 60°) and fingers 1 and 2 at φy = ``upper_tilt`` (deg; None: Table
+    5-1's -15°), no legs. The drums keep one timing whatever the start,
+    :func:`designed_phase` for Table 5-4's X0 = -0.305 m, turned on by
+    ``phase`` (deg)."""
     s = thesis_setup(0.0, FOOTBALL_DURATION, "hard", "football.yaml", start,
                      "decelerate_figure_5_10.yaml", friction, Legs(0.0, 0.0), model)
     s = with_phi_x(replace(s, conveyor_friction=1.16), "3", phi_x3)
-    if tilted:
-        mean = load_model(read_bird, "birds", "mean_1_80kg.yaml")
-        tilts = upper_tilt(s.grasper, s.bird, mean, s.drum_speed)
-        s = replace(s, grasper=s.grasper.remounted({n: {"phi_y": a} for n, a in tilts.items()}))
-    return designed_phase(s) if phased else s
+    if upper_tilt is not None:
+        tilt = np.radians(upper_tilt)
+        s = replace(s, grasper=s.grasper.remounted({n: {"phi_y": tilt} for n in ("1", "2")}))
+    return turned(designed_phase(s, FOOTBALL_START), phase)
 
 
 def sizes_setup(bird: str) -> GraspSetup:
     """A Table 5-5 bird from X0 = -0.381 m, µ = 0.4, on the Figure 5-10 belt
     (the football studies' profiles; Figure 5-19's X axis starts at -0.25 m),
-    the drums in :func:`designed_phase`."""
-    return designed_phase(thesis_setup(0.0, FOOTBALL_DURATION, "hard", f"{bird}.yaml",
-                                       SIZES_START, "decelerate_figure_5_10.yaml", 0.4, Legs(),
-                                       VALIDATION_MODEL))
+    the Table 5-1 grasper in the football's drum timing (:func:`football_setup`):
+    §5.4 runs the football's studies with another bird."""
+    s = thesis_setup(0.0, FOOTBALL_DURATION, "hard", f"{bird}.yaml", SIZES_START,
+                     "decelerate_figure_5_10.yaml", 0.4, Legs(), VALIDATION_MODEL)
+    return designed_phase(s, FOOTBALL_START)
 
 
 def simulate_all(setups: dict[str, GraspSetup], progress=None,

@@ -13,7 +13,7 @@ from design import __version__
 from design.io.results import csv_text, json_text
 from design.report.page import Page, write_report
 from design.reproduce import beam_rows, contact_rows, grasp_rows
-from design.reproduce.rows import COLUMNS, Section, tally, tally_by_basis, verdict
+from design.reproduce.rows import COLUMNS, CaseFailed, Section, tally, tally_by_basis, verdict
 
 HOW_TO_READ = (
     "Each row sets a number or a claim of the thesis beside ours. A numeric row agrees when "
@@ -21,14 +21,17 @@ HOW_TO_READ = (
     "last printed digit, widened only where the thesis states a coarser accuracy (e.g. its "
     "contact solver's ERR = 0.5 mm), where its number is a reading of a plot, or where it "
     "depends on inputs it gives roughly or not at all; each section says which. A claim row (a "
-    "trend "
-    "or a bound) agrees when ours bears it out by the criterion in its explanation. The "
-    "'basis' column says what ours is compared with: a number the thesis prints, a statement "
-    "it makes (both from its own calculations and simulations), what its football experiment "
-    "measured, or, where it prints nothing, one of our own references (a closed form, a finer "
-    "method); no tolerance is derived from our own results. SI units: "
-    "m, N, s, rad, N m^2 (the thesis's degrees converted). Disagreements are findings, not "
-    "failures: their explanations say what we think causes them.")
+    "trend or a bound) agrees when ours bears it out by the criterion in its explanation. The "
+    "'basis' column says what ours is compared with, and the verdict counts each apart: a "
+    "thesis measurement (the football experiment of §5.3: its rise and what its video shows), "
+    "a thesis simulation (the thesis's own calculations and simulations; 'kind' says whether "
+    "it printed a number or a statement), or, where it prints nothing, an own reference (a "
+    "closed form, a finer method); no tolerance is derived from our own results. Context rows "
+    "are shown and never counted: a quantity of ours beside a different one of the thesis's, "
+    "or a reading the thesis leaves open (the pallet, the spread over unprinted settings). SI "
+    "units: m, N, s, rad, N m^2 (the thesis's degrees converted). Disagreements are findings, "
+    "not failures: their explanations say what we think causes them, or which candidate "
+    "causes were measured and ruled out.")
 
 
 def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
@@ -41,9 +44,19 @@ def _chapters(quick: bool) -> list[tuple[str, Callable[..., list[Section]]]]:
     ]
     if not quick:
         chapters.append((f"chapter V: grasp figures ({len(grasp_rows.setups())} runs, most with "
-                         "the spatial finger model)",
-                         lambda progress: grasp_rows.sections(grasp_rows.compute(progress))))
+                         "the spatial finger model)", _grasp_sections))
     return chapters
+
+
+def _grasp_sections(progress) -> list[Section]:
+    """Chapter V's section; raises CaseFailed after building it if a run failed
+    (its rows say which)."""
+    runs = grasp_rows.compute(progress)
+    built = grasp_rows.sections(runs)
+    failed = grasp_rows.failures(runs)
+    if failed:
+        raise CaseFailed("; ".join(failed), built)
+    return built
 
 
 def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[str]]:
@@ -55,6 +68,9 @@ def compute_sections(quick: bool, progress=None) -> tuple[list[Section], list[st
             progress(f"{name} ...")
         try:
             sections += build(progress)
+        except CaseFailed as exc:  # some cases failed: the rest is reported
+            sections += exc.sections
+            failures.append(f"{name}: could not be computed: {type(exc).__name__}: {exc}")
         except Exception as exc:  # noqa: BLE001  (any solver error: report it, go on)
             failures.append(f"{name}: could not be computed: {type(exc).__name__}: {exc}")
         if progress:
@@ -91,6 +107,8 @@ def build_page(sections: list[Section], failures: list[str], quick: bool,
         page.text(s.text)
         if s.rows:
             page.table([r.as_dict() for r in s.rows], table_id=f"rows-{s.anchor}", digits=6)
+        for name, caption, table in s.tables:
+            page.table(table, caption, table_id=f"{s.anchor}-{name}", digits=4)
         for fig, name, caption in s.figures:
             page.figure(fig, name, caption)
     wall = time.perf_counter() - started
@@ -113,6 +131,9 @@ def reproduce(out: Path, quick: bool, progress=None) -> tuple[list[Path], str, b
               "failures": failures, "agree": agree, "total": total,
               "by_basis": {b: {"agree": k, "total": n}
                            for b, (k, n) in tally_by_basis(rows).items()},
+              "context_rows": sum(not r.counted for r in rows),
+              "tables": {f"{s.anchor}-{name}": {"caption": caption, "rows": table}
+                         for s in sections for name, caption, table in s.tables},
               "columns": list(COLUMNS),
               "rows": [r.as_dict() for r in rows]}
     files = {"reproduction.json": json_text(result),

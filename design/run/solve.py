@@ -532,7 +532,8 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: S
             "final_nlp": None if view is None else {
                 "ipopt_status": view.status, "iterations": view.iterations,
                 "wall_time_s": view.wall_time,
-                "constraint_violation": view.history[-1]["violation"] if view.history else None},
+                "constraint_violation": view.violation if view.history else None,
+                "iteration_returned": view.iteration},
             "history": iterations,
             "settings": {"time_step_s": problem.settings.nlp.time_step,
                          "beam_intervals": problem.settings.nlp.beam_intervals,

@@ -70,7 +70,7 @@ def study(problem: DesignProblem, quick: bool = False, progress: Progress | None
             view, error = None, str(exc)
         wall = time.perf_counter() - t0
         hold = view.hold_time if view is not None else math.nan
-        violation = view.history[-1]["violation"] if view is not None and view.history \
+        violation = view.violation if view is not None and view.history \
             else math.nan
         note = "" if feasible(view) else \
             f"the NLP could not be built or solved: {error}" if view is None else \

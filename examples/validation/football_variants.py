@@ -1,4 +1,4 @@
-"""Two explanations of Figures 5-17/5-18 tried and ruled out: run
+"""Two candidate explanations of Figures 5-17/5-18: run
 from the repository root,
 ``.venv/bin/python examples/validation/football_variants.py [--out DIR]``.
 

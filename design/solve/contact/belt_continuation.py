@@ -36,7 +36,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from design.solve.buffers import Buffered
-from design.solve.contact.robust import BASE_REACHED, MAX_STEP_ITERATIONS
+from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS
 from design.solve.contact.spatial import CHORD_ITERATIONS
 
 #: a contact event is located to within this penetration (m) ...
@@ -319,6 +319,35 @@ class BeltedContact:
         ``release-belt``), to start (``bird``, ``belt``), a switch between
         interior and tip (``to-tip``, ``to-interior``), the contact at the
         base (``base``)."""
+        mode, post = state.mode, state.post
+        if mode in BIRD_MODES:
+            if self.pulls(post):
+                return "release-bird", 0.0
+            arc = post[self.POST_ARC]
+            interior = mode.startswith("interior")
+            if interior and arc > self.length * (1 + 1e-12):
+                return "to-tip", 0.0
+            if interior and arc <= BASE_FRACTION * self.length:
+                return "base", 0.0
+            if not interior and post[self.POST_ALONG] > 0:
+                return "to-interior", 0.0
+        if mode in BELT_MODES:
+            if post[self.POST_BELT_FORCE] < 0:
+                return "release-belt", 0.0
+        elif self.depth(state, "belt") > 0.0:
+            return "belt", self.depth(state, "belt")
+        if mode not in BIRD_MODES and self.excess(state, "bird") > 0.0:
+            return "bird", self.excess(state, "bird")
+        return None
+
+    #: where the post values hold the bird's contact arc length, the tangency
+    #: d1·n (tip contact) and the belt's normal force
+    POST_ARC: int
+    POST_ALONG: int
+    POST_BELT_FORCE: int
+
+    def pulls(self, post: np.ndarray) -> bool:
+        """Whether the bird's contact force would pull the finger into the bird."""
         raise NotImplementedError
 
     def switch(self, state: Belted, kind: str) -> Belted | None:

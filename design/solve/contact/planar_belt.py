@@ -139,26 +139,10 @@ class PlanarBeltContact(BeltedContact):
             post[:12], tip, [0.0, float(state.plane.level(tip[:, None])[0]),
                              float(t_f @ state.plane.normal), 0.0, 0.0]]))
 
-    def event(self, state: Belted) -> tuple[str, float] | None:
-        mode, post = state.mode, state.post
-        if mode in BIRD_MODES:
-            if post[3] > 0 and post[8] <= 0:
-                return "release-bird", 0.0
-            interior = mode.startswith("interior")
-            if interior and post[5] > self.length * (1 + 1e-12):
-                return "to-tip", 0.0
-            if interior and post[5] <= BASE_FRACTION * self.length:
-                return "base", 0.0
-            if not interior and post[7] > 0:
-                return "to-interior", 0.0
-        if mode in BELT_MODES:
-            if post[POST_BELT_FORCE] < 0:
-                return "release-belt", 0.0
-        elif self.depth(state, "belt") > 0.0:
-            return "belt", self.depth(state, "belt")
-        if mode not in BIRD_MODES and self.excess(state, "bird") > 0.0:
-            return "bird", self.excess(state, "bird")
-        return None
+    POST_ARC, POST_ALONG, POST_BELT_FORCE = 5, 7, POST_BELT_FORCE
+
+    def pulls(self, post: np.ndarray) -> bool:
+        return bool(post[3] > 0 and post[8] <= 0)
 
     def depth(self, state: Belted, kind: str) -> float:
         if kind == "belt":

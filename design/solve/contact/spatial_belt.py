@@ -116,27 +116,10 @@ class SpatialBeltContact(BeltedContact):
         return replace(state, post=np.concatenate([
             post[:19], tip, [0.0, level, float(post[13:16] @ state.plane.normal)], np.zeros(6)]))
 
-    def event(self, state: Belted) -> tuple[str, float] | None:
-        mode, post = state.mode, state.post
-        if mode in BIRD_MODES:
-            if post[3] < 0:
-                return "release-bird", 0.0
-            arc = post[4]
-            interior = mode.startswith("interior")
-            if interior and arc > self.length * (1 + 1e-12):
-                return "to-tip", 0.0
-            if interior and arc <= BASE_FRACTION * self.length:
-                return "base", 0.0
-            if not interior and post[6] > 0:
-                return "to-interior", 0.0
-        if mode in BELT_MODES:
-            if post[POST_BELT_FORCE] < 0:
-                return "release-belt", 0.0
-        elif self.depth(state, "belt") > 0.0:
-            return "belt", self.depth(state, "belt")
-        if mode not in BIRD_MODES and self.excess(state, "bird") > 0.0:
-            return "bird", self.excess(state, "bird")
-        return None
+    POST_ARC, POST_ALONG, POST_BELT_FORCE = 4, 6, POST_BELT_FORCE
+
+    def pulls(self, post: np.ndarray) -> bool:
+        return bool(post[3] < 0)
 
     def depth(self, state: Belted, kind: str) -> float:
         if kind == "belt":

@@ -44,7 +44,7 @@ import numpy as np
 
 from design.physics.belt import Belt
 from design.physics.bird import Bird, Loads
-from design.physics.contact import ContactSolution, straight_overlap
+from design.physics.contact import ContactSolution
 from design.physics.ellipse import Ellipse
 from design.physics.grasper import Grasper
 from design.physics.kinematics import Ellipsoid
@@ -264,15 +264,11 @@ class PlanarFinger:
             [[law.mu, law.speed], law.sliding_at_origin[:2], law.sliding_gradient[:2, :2].ravel()])
 
     def _belted_solve(self, body, base, R, kin_factory, start, commit, line):
-        """The finger with the belt; the bird's section taken in where the
-        plane cuts the bird near enough for the bent finger to reach it."""
+        """The finger with the belt; the bird's section by the bending plane,
+        where the plane cuts the bird (its continuation finds where the bent
+        finger first meets it)."""
         center, B, rhs = body.section(base, R)
-        length = self.solver.finger.length
-        depth = -line[0].level(np.array([[length], [0.0]]))[0]
-        conic = None
-        if rhs > 0.0 and (straight_overlap(center, _grown_conic(B, depth), length) < 0.0
-                          or (start is not None and start.bird is not None)):
-            conic = (center, B)
+        conic = (center, B) if rhs > 0.0 else None
         tau_mu = self._bird_friction(start, conic, kin_factory, body, base, R)
         sol, cont = self.belted.solve(conic, tau_mu, *line, previous=start, detail=commit)
         return self._world(base, R, sol, cont)
@@ -382,32 +378,13 @@ class SpatialFinger:
         return post[:3] + post[13:16] * (self.solver.finger.length - post[4])
 
     def _belted_solve(self, body, quadric, base, R, kin_factory, start, commit, belt):
-        """The finger with the belt; the bird taken in only where the finger may reach it."""
-        near = segment_level(_grown(quadric, -belt[0].level(
-            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0]),
-            self.solver.finger.length) < 0.0
-        near = near or (start is not None and start.bird is not None)
-        sol, cont = self.belted.solve(quadric if near else None,
-                                      self._law(kin_factory, quadric) if near else FrictionLaw(),
-                                      belt[0], belt[1], start, detail=commit)
+        """The finger with the belt and the bird (its continuation finds where
+        the bent finger first meets the bird)."""
+        sol, cont = self.belted.solve(quadric, self._law(kin_factory, quadric), belt[0], belt[1],
+                                      start, detail=commit)
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
-
-
-def _grown_conic(B: np.ndarray, margin: float) -> np.ndarray:
-    """The conic matrix of an ellipse with every semi-axis longer by ``margin`` (m)."""
-    values, vectors = np.linalg.eigh(B)
-    axes = 1.0 / np.sqrt(values) + max(margin, 0.0)
-    return vectors @ np.diag(1.0 / axes ** 2) @ vectors.T
-
-
-def _grown(quadric: Quadric, margin: float) -> Quadric:
-    """The ellipsoid ``quadric`` with every semi-axis longer by ``margin`` (m):
-    it contains every point within ``margin`` of the original."""
-    values, vectors = np.linalg.eigh(quadric.matrix)
-    axes = 1.0 / np.sqrt(values) + max(margin, 0.0)
-    return Quadric(quadric.center, vectors @ np.diag(1.0 / axes ** 2) @ vectors.T)
 
 
 class ThesisPlanarFinger(PlanarFinger):
@@ -426,15 +403,12 @@ class ThesisPlanarFinger(PlanarFinger):
 FINGER_MODELS = {m.name: m for m in (PlanarFinger, ThesisPlanarFinger, SpatialFinger)}
 
 
-def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length,
-                   grow: float = 0.0):
+def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
     """min over the straight finger (base + x axis, 0 ≤ x ≤ length) of the
     bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
     1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
-    For n fingers at once: base and axis (n, 3), length (n,); returns (n,).
-    ``grow`` (m; one value or one per finger): the bird with every semi-axis
-    that much longer (it then holds every point within ``grow`` of the bird)."""
-    scale = 1.0 / (np.array([body.eta, body.lam, body.gamma]) + np.asarray(grow)[..., None])
+    For n fingers at once: base and axis (n, 3), length (n,); returns (n,)."""
+    scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
     p = scale * ((base - np.asarray(body.center)) @ body.rotation)
     e = scale * (axis @ body.rotation)
     x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
@@ -509,12 +483,13 @@ class FingerForces:
         bases, rotations = self.frames(t)
         return bases[i], rotations[i]
 
-    def reaching(self, t: float, body: Ellipsoid, commit: bool = False) -> set[int]:
+    def reaching(self, t: float, body: Ellipsoid) -> set[int]:
         """The fingers to solve at time t, among those inside their reach
         windows (the others count as skipped): those whose straight line
         enters the bird (level ≤ MISSES), and those resting on the belt (the
-        straight tip below it), at an accepted instant all of them, else while
-        the bird comes within the tip's depth of the straight finger."""
+        straight tip below it), which the bird may meet bent: every
+        evaluation solves the same ones, so that a trial sees what the
+        accepted instant will."""
         if self._window_ends is None:
             inside = np.arange(len(self.models))
         else:
@@ -530,11 +505,7 @@ class FingerForces:
         depth = -tips[:, 2]
         resting = (depth > 0) & np.array([self.belt.touches(self.grasper.fingers[i].design_name,
                                                            tip[1]) for i, tip in zip(inside, tips)])
-        if commit or not np.any(resting):
-            return out | set(inside[resting].tolist()) if commit else out
-        near = straight_level(body, bases[inside[resting]], axes[resting], lengths[resting],
-                              grow=depth[resting]) <= MISSES
-        return out | set(inside[resting][near].tolist())
+        return out | set(inside[resting].tolist())
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the
@@ -579,7 +550,7 @@ class FingerForces:
         body = self.ellipsoid(y)
         loads, states = Loads(), []
         centre = np.array([y[0], 0.0, y[1]])
-        reaching = self.reaching(t, body, commit)
+        reaching = self.reaching(t, body)
         for i, gf in enumerate(self.grasper.fingers):
             force = None
             if i in reaching:

@@ -48,6 +48,10 @@ OBJECTIVE_SCALE = 0.1
 MIN_DURATION = 1e-4
 #: the NLP's bound on the bird's pitch (rad): the optimiser does not design tumbles
 MAX_PITCH = 1.5
+#: an iterate this feasible (largest violation, in the constraints' units) may
+#: stand for a solve that ended infeasible (an iteration limit, a stall): the
+#: best of them, by the objective, is its answer
+FEASIBLE_ITERATE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -128,10 +132,18 @@ class NLPResult:
     lam_x: np.ndarray
     #: the largest finger force (N) of each bird (default: one bird, ``peak_force``)
     peaks: np.ndarray | None = None
+    #: the largest constraint violation at x (default: the last iteration's)
+    violation: float | None = None
+    #: the Ipopt iteration x is from (default: the last)
+    iteration: int | None = None
 
     def __post_init__(self):
         if self.peaks is None:
             self.peaks = np.array([self.peak_force])
+        if self.violation is None:
+            self.violation = self.history[-1]["violation"] if self.history else np.inf
+        if self.iteration is None:
+            self.iteration = len(self.history) - 1
 
 
 class DesignNLP:
@@ -482,6 +494,13 @@ class DesignNLP:
             raise NLPFailed(f"Ipopt ended on an error, {stats['return_status']}, after "
                             f"{stats['iter_count']} iterations")
         x = np.asarray(sol["x"]).ravel()
+        violation, iteration = (history[-1]["violation"], len(history) - 1) if history else \
+            (np.inf, -1)
+        if violation > FEASIBLE_ITERATE and callback.best is not None:
+            # an iteration limit or a stall left Ipopt infeasible after a feasible
+            # iterate: that one is the solve's answer
+            iteration, x = callback.best
+            violation = history[iteration]["violation"]
         try:
             with _casadi_output_muted():
                 force = np.asarray(self.functions(x)[2]).ravel()
@@ -492,7 +511,7 @@ class DesignNLP:
                          float(peaks.max()), stats["return_status"],
                          bool(stats["success"]), int(stats["iter_count"]), wall, self.size,
                          history, x, np.asarray(sol["lam_g"]).ravel(),
-                         np.asarray(sol["lam_x"]).ravel(), peaks)
+                         np.asarray(sol["lam_x"]).ravel(), peaks, violation, iteration)
 
     def durations(self, x: np.ndarray) -> np.ndarray:
         """The phase durations (s) in the solution x."""
@@ -574,11 +593,14 @@ class _Progress(ca.Callback):
         self.streams = sys.stdout, sys.stderr
         #: an exception in the callback, which ends the solve as an error
         self.error: Exception | None = None
+        #: (iteration, x) of the best iterate within FEASIBLE_ITERATE (the least f)
+        self.best: tuple[int, np.ndarray] | None = None
+        self._best_f = np.inf
         self.construct("progress", {})
 
     def restart(self, history: list) -> None:
-        """For a new solve: record into ``history``, no error yet."""
-        self.history, self.error = history, None
+        """For a new solve: record into ``history``, no error yet, no best iterate."""
+        self.history, self.error, self.best, self._best_f = history, None, None, np.inf
 
     def get_n_in(self):
         return ca.nlpsol_n_out()
@@ -613,8 +635,12 @@ class _Progress(ca.Callback):
 
     def _record(self, arg) -> None:
         g = np.asarray(arg[ca.nlpsol_out().index("g")]).ravel()
-        hold = float(arg[ca.nlpsol_out().index("x")][self.hold_index])
+        x = arg[ca.nlpsol_out().index("x")]
+        hold = float(x[self.hold_index])
         violation = float(np.max(np.concatenate([[0.0], self.lbg - g, g - self.ubg])))
+        f = float(arg[ca.nlpsol_out().index("f")])
+        if violation <= FEASIBLE_ITERATE and f < self._best_f:
+            self.best, self._best_f = (len(self.history), np.asarray(x).ravel().copy()), f
         self.history.append({"iteration": len(self.history), "hold_time_s": hold,
                              "violation": violation})
         if self.report:

@@ -319,14 +319,16 @@ def optimise(space: DesignSpace | Population, cap, settings: LoopSettings,
             "iteration": it + 1, "radius": radius, "nlp_cap_N": caps_value(cap_nlp),
             "ipopt_status": result.status, "ipopt_iterations": result.iterations,
             "nlp_wall_time_s": result.wall_time, "nlp_hold_time_s": result.hold_time,
-            "nlp_peak_force_N": result.peak_force, "candidate_scaled": result.d.tolist(),
+            "nlp_peak_force_N": result.peak_force, "nlp_violation": result.violation,
+            "nlp_iteration_returned": result.iteration, "candidate_scaled": result.d.tolist(),
             "simulated_hold_time_s": candidate.hold,
             "simulated_peak_force_N": candidate.peak, "accepted": accepted,
             "grid_reproduces_simulation": reproduced, "view_error": view_error,
             "view": None if view is None else {
                 "ipopt_status": view.status, "ipopt_iterations": view.iterations,
                 "wall_time_s": view.wall_time, "hold_time_s": view.hold_time,
-                "constraint_violation": view.history[-1]["violation"] if view.history else None},
+                "constraint_violation": view.violation if view.history else None,
+                "iteration_returned": view.iteration},
             "nlp_size": result.size, "history": result.history,
             **({} if len(caps) == 1 else {
                 "simulated_hold_times_s": candidate.holds.tolist(),
@@ -391,8 +393,7 @@ VIEW_FEASIBLE = 1e-2
 
 
 def feasible(result: NLPResult | None) -> bool:
-    return result is not None and bool(result.history) and \
-        result.history[-1]["violation"] < VIEW_FEASIBLE
+    return result is not None and bool(result.history) and result.violation < VIEW_FEASIBLE
 
 
 def optimiser_hold(view: NLPResult | None, accepted: NLPResult | None) -> tuple[float, str]:

@@ -1,0 +1,63 @@
+"""The robustness table (design/solve/optimize/robustness.py): each perturbed
+scene changes the one thing it names, and the optimum beats the baseline
+only where it holds longer, keeps the cap and does not jam."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from design.io.scene import load_scene
+from design.run.grasp import setup_of
+from design.solve.optimize.robustness import CASES, robustness_text, scenes, table
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def scene_setups():
+    setup = setup_of(load_scene(ROOT / "problems" / "grasp_mean_bird_hard_spatial.yaml"))
+    return setup, dict(zip([name for name, _ in CASES], scenes(setup)))
+
+
+def test_each_scene_changes_what_it_names(scene_setups):
+    """µ_f, drum phase (every finger 10° on, t = 0), bird, EI (every finger,
+    every section), slots for finger 5; the nominal scene is the design's."""
+    base, by_name = scene_setups
+    assert by_name["nominal (finger µ 0.4, solid belt)"] == base
+    assert by_name["finger µ 0"].finger_friction == 0.0
+    assert by_name["finger µ 0.2"].finger_friction == 0.2
+    turned = by_name["drum phase +10°"].grasper.fingers
+    assert [f.mount.angle for f in turned] == pytest.approx(
+        [f.mount.angle - np.radians(10.0) for f in base.grasper.fingers])
+    assert by_name["2.05 kg bird"].bird.mass == pytest.approx(2.05)
+    assert by_name["1.20 kg bird"].bird.mass == pytest.approx(1.20)
+    soft = by_name["finger EI -20 %"].grasper.fingers
+    for f, g in zip(soft, base.grasper.fingers):
+        s = np.linspace(0.0, g.finger.length, 5)
+        assert f.finger.stiffness.ei(s) == pytest.approx(0.8 * g.finger.stiffness.ei(s))
+    assert by_name["finger 5 through a slotted pallet"].belt.slots == frozenset({"5"})
+    assert base.belt.solid
+
+
+def run(hold: float, peak: float, jam: list | None = None, ok: bool = True) -> dict:
+    return {"hold_time_s": hold, "max_finger_force_N": peak, "max_finger_force_finger": "5b",
+            "jam": jam or [], "ok": ok, "message": "" if ok else "finger 5b's contact failed"}
+
+
+def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_unjammed():
+    """Cap 20 N (1 % tolerance): longer and under it beats; shorter, over the
+    cap by more than 1 %, jammed, or a run that ended early does not."""
+    n = len(CASES)
+    base = [run(0.35, 19.0)] * n
+    opt = [run(0.40, 19.0), run(0.34, 18.0), run(0.40, 20.3), run(0.40, 18.0, ["finger 5b ..."]),
+           run(0.40, 18.0, ok=False)] + [run(0.40, 20.1)] * (n - 5)
+    t = table(base, opt, 20.0)
+    beats = [r["optimum_beats_baseline"] for r in t["cases"]]
+    assert beats[:5] == [True, False, False, False, False] and all(beats[5:])
+    assert t["share_beaten"] == pytest.approx((n - 4) / n)
+    assert t["broken_by"] == [name for name, _ in CASES[1:5]]
+    assert t["cases"][4]["optimum_jam"].startswith("the run ended early")
+    assert robustness_text(t).startswith(f"the optimum beats the baseline in {n - 4} of {n}")
