@@ -35,7 +35,7 @@ from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
 from design.reproduce.grasp import load_model
-from design.solve.beam import METHODS, solve_beam
+from design.solvers.beam import METHODS, solve_beam
 from design.tradeoff.beam import RESOLUTIONS, reference, tips
 from design.tradeoff.study import timed
 

@@ -44,8 +44,8 @@ from benchmarks.results_file import write_results
 from design.io.fingers import read_finger
 from design.physics.beam import PointLoad
 from design.reproduce.grasp import load_model
-from design.solve import compiled
-from design.solve.beam import solve_beam
+from design.solvers import compiled
+from design.solvers.beam import solve_beam
 from design.tradeoff.beam import REFERENCE_INTERVALS, tips
 
 RESULTS = Path(__file__).parent / "results" / "beam_sweep.json"

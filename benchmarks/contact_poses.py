@@ -34,7 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from design.physics.contact import SIDES
-from design.solve.contact import RobustContact
+from design.solvers.contact import RobustContact
 from tests.contact_reference import reference
 from tests.problems import entering_poses, thesis_finger
 

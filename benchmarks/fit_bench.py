@@ -39,15 +39,15 @@ import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (
 import numpy as np
 
 from benchmarks.results_file import write_results
-from design.fit.convex import fit_compliance
-from design.fit.elastica import uniform_fit
-from design.fit.kernel import KnotCompliance, kernel
-from design.fit.refinement import refine
+from design.calibration.convex import fit_compliance
+from design.calibration.elastica import uniform_fit
+from design.calibration.kernel import KnotCompliance, kernel
+from design.calibration.refinement import refine
 from design.io.scene import load_fit
 from design.physics.beam import Finger
 from design.run.finger_fit import DETERMINED_BAND
 from design.run.fit import run
-from design.solve.beam.collocation import Collocation
+from design.solvers.beam.collocation import Collocation
 from tests.fit_benches import (FAMILY, NOISE, READINGS, STEPPED, TUNING, readings, score,
                                write_problem)
 

@@ -29,8 +29,8 @@ from pathlib import Path
 
 from benchmarks.results_file import write_results
 from design.reproduce.grasp import thesis_setup
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import simulate_grasp
 from design.tradeoff.grasp import CASES, DEFAULT
 
 RESULTS = Path(__file__).parent / "results" / "grasp.json"

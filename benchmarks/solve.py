@@ -64,7 +64,7 @@ Prints the tables and writes benchmarks/results/solve.json.
 Where the main job's time goes: the whole ``design solve
 problems/hold_time.yaml`` through the public API (``design.api.solve``), its
 profile (wall time per phase, each CasADi function's evaluation time and
-calls, Ipopt's own time, peak memory: design/solve/optimize/profile.py)
+calls, Ipopt's own time, peak memory: design/solvers/optimize/profile.py)
 printed as a table and written to solve.json's ``main_job``, with its
 status, verified and optimiser hold, and the machine's cores and load at
 the start and end; the sizes record their wall time and the load averages
@@ -96,10 +96,10 @@ import numpy as np
 from benchmarks.results_file import write_results
 from design.api import check, solve
 from design.run.solve import design_space
-from design.solve.optimize.profile import profile_text
-from design.solve.optimize.schedule import schedule_of
-from design.solve.optimize.transcription import DesignNLP, NLPFailed
-from design.solve.optimize.trust_region import simulate
+from design.solvers.optimize.profile import profile_text
+from design.solvers.optimize.schedule import schedule_of
+from design.solvers.optimize.transcription import DesignNLP, NLPFailed
+from design.solvers.optimize.trust_region import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = Path(__file__).parent / "results" / "solve.json"

@@ -26,8 +26,8 @@ from pathlib import Path
 
 from benchmarks.results_file import write_results
 from design.reproduce.grasp import football_setup, mean_bird_setup
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import simulate_grasp
 
 RESULTS = Path(__file__).parent / "results" / "spatial_mesh.json"
 MESHES = (2, 3, 4, 6)

@@ -30,7 +30,7 @@ from pathlib import Path
 import yaml
 
 from design.api import solve
-from design.solve.optimize.profile import STUDY
+from design.solvers.optimize.profile import STUDY
 from design.study.store import STORE, read_cases
 
 ROOT = Path(__file__).resolve().parents[1]

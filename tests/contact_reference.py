@@ -1,6 +1,6 @@
 """An independent reference for a finger against an ellipse (the planar model).
 
-Two steps, neither shared with :mod:`design.solve.contact`:
+Two steps, neither shared with :mod:`design.solvers.contact`:
 
 1. *Least energy*: the finger as N rigid links with bending springs,
    minimising the elastic energy ∫ M²/(2 EI) ds with every node outside the

@@ -28,9 +28,9 @@ import pytest
 from design.io.grasp_scene import GraspSettings, read_grasper
 from design.io.scene_writer import grasp_spec
 from design.reproduce.grasp import advanced, load_model, thesis_setup
-from design.solve.grasp import simulation
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
+from design.solvers.grasp import simulation
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.optimize.variables import DesignSpace, Variable, timed_conveyor
 from tests import prefetch
 
 GRASPER = Path(__file__).parent / "data" / "one_set_grasper.yaml"
@@ -96,7 +96,7 @@ def _inputs(setup, integrator, contact_nodes, reach_filter) -> str:
 
 def shared_simulate_grasp(setup, integrator: IntegratorSettings = IntegratorSettings(),
                           contact_nodes: int = 6, reach_filter: bool = True, progress=None):
-    """:func:`~design.solve.grasp.simulation.simulate_grasp`, run once per
+    """:func:`~design.solvers.grasp.simulation.simulate_grasp`, run once per
     distinct input in the session; the run returned carries the caller's
     setup. Without a wall-time limit the simulation is deterministic, so a
     repeat would give the same run; its records are shared, so a test must
@@ -122,10 +122,10 @@ COMPILE = "tests/design_cases.py: the design NLP's compiled finger functions"
 def compile_finger_loads() -> int:
     """Build the short grasp's finger functions for the design NLP (6
     intervals, degree 4, both contact modes), which compiles them into the
-    cache (design/solve/compiled.py) if they are not there: about 7 s of gcc
+    cache (design/solvers/compiled.py) if they are not there: about 7 s of gcc
     on an empty cache that the optimiser tests would otherwise wait for.
     Returns how many fingers were built."""
-    from design.solve.optimize.finger_load import FingerLoad
+    from design.solvers.optimize.finger_load import FingerLoad
     setup = short_setup()
     for gf in setup.grasper.fingers:
         FingerLoad(gf, setup.grasper, setup.bird, setup.finger_friction, 6, 4)
@@ -151,7 +151,7 @@ def asked(call) -> tuple:
              progress=None):
         raise _Asked(setup, integrator, contact_nodes, reach_filter)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr("design.solve.optimize.trust_region.simulate_grasp", stop)
+        patch.setattr("design.solvers.optimize.trust_region.simulate_grasp", stop)
         try:
             call()
         except _Asked as found:
@@ -166,7 +166,7 @@ def prefetch_jobs(settings) -> list[tuple[str, tuple, list[str]]]:
     verification's 4x finer resolution, the stiff design at the loop's, and
     the baseline at the scenes' default tolerance. ``settings``: the
     optimiser tests' LoopSettings (their time step sets the verification's)."""
-    from design.solve.optimize.trust_region import simulate, verify
+    from design.solvers.optimize.trust_region import simulate, verify
     space = stiffness_space("lower", hi=2.0)
     base = space.scale(space.base_values)
     design = ["tests/test_design_solve.py::test_verification_catches_a_design_over_the_cap",
@@ -194,6 +194,6 @@ def sharing_simulations():
     verifications) and ``design simulate`` of a grasp scene use
     :func:`shared_simulate_grasp`."""
     with pytest.MonkeyPatch.context() as patch:
-        for module in ("design.solve.optimize.trust_region", "design.run.grasp"):
+        for module in ("design.solvers.optimize.trust_region", "design.run.grasp"):
             patch.setattr(f"{module}.simulate_grasp", shared_simulate_grasp)
         yield

@@ -29,8 +29,8 @@ import casadi as ca
 import numpy as np
 import yaml
 
-from design.fit.data import FingerData, Observation
-from design.fit.elastica import elastica_predictions
+from design.calibration.data import FingerData, Observation
+from design.calibration.elastica import elastica_predictions
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import ExponentialI, Stiffness
 

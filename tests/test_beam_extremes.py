@@ -7,7 +7,7 @@ import pytest
 
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
-from design.solve.beam import METHODS, solve_beam
+from design.solvers.beam import METHODS, solve_beam
 from tests.problems import thesis_finger, tip_distance
 
 NUMERICAL = ["shooting", "fdm", "collocation"]

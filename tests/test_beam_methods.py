@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 from design.physics.beam import PointLoad
-from design.solve.beam import METHODS, solve_beam
-from design.solve.beam.collocation import BeamTranscription
+from design.solvers.beam import METHODS, solve_beam
+from design.solvers.beam.collocation import BeamTranscription
 from tests.closed_forms import shoot_transverse, transverse_cantilever
 from tests.problems import (table_2_1, table_2_3, table_finger, thesis_finger, tip_distance,
                             uniform_finger)

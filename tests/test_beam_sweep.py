@@ -11,9 +11,9 @@ import pytest
 
 from design.physics.beam import PointLoad
 from design.physics.stiffness import UniformEI
-from design.solve import compiled as comp
-from design.solve.beam import collocation, solve_beam, sweep
-from design.solve.beam.collocation import BeamTranscription
+from design.solvers import compiled as comp
+from design.solvers.beam import collocation, solve_beam, sweep
+from design.solvers.beam.collocation import BeamTranscription
 from tests.problems import table_2_3, thesis_finger, tip_distance
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -1,4 +1,4 @@
-"""A finger pressed on the moving belt, alone and with the bird (design/solve/
+"""A finger pressed on the moving belt, alone and with the bird (design/solvers/
 contact/belt_continuation.py and its two finger models).
 
 References independent of the toolkit's collocation: the elastica with a
@@ -24,11 +24,11 @@ from scipy.integrate import solve_bvp
 from design.physics.beam import Finger
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
-from design.solve.contact import RobustContact
-from design.solve.contact.belt_continuation import Belted, Plane
-from design.solve.contact.planar_belt import PlanarBeltContact
-from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact
-from design.solve.contact.spatial_belt import SpatialBeltContact
+from design.solvers.contact import RobustContact
+from design.solvers.contact.belt_continuation import Belted, Plane
+from design.solvers.contact.planar_belt import PlanarBeltContact
+from design.solvers.contact.spatial import FrictionLaw, Quadric, SpatialContact
+from design.solvers.contact.spatial_belt import SpatialBeltContact
 from tests.problems import thesis_finger
 
 LENGTH = 0.152

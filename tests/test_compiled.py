@@ -1,14 +1,14 @@
-"""Compiled CasADi functions (design/solve/compiled.py): the same outputs as
+"""Compiled CasADi functions (design/solvers/compiled.py): the same outputs as
 the interpreted ones, a cache that builds once, the interpreted fallback
 when there is no compiler or it fails; and the optimiser's finger function
-(design/solve/optimize/finger_load.py), whose explicit Jacobian must equal
+(design/solvers/optimize/finger_load.py), whose explicit Jacobian must equal
 CasADi's derivative of the rootfinder it replaces."""
 
 import casadi as ca
 import numpy as np
 import pytest
 
-from design.solve import compiled as comp
+from design.solvers import compiled as comp
 
 
 @pytest.fixture
@@ -100,8 +100,8 @@ def pressing_contact(setup, finger: int, t: float):
     from design.physics.contact import FingerPose
     from design.physics.ellipse import Ellipse
     from design.physics.kinematics import finger_frame, section
-    from design.solve.contact.robust import RobustContact
-    from design.solve.optimize.variables import parameters_of
+    from design.solvers.contact.robust import RobustContact
+    from design.solvers.optimize.variables import parameters_of
 
     v, gf, bird = parameters_of(setup), setup.grasper.fingers[finger], setup.bird
     key = f"fingers.{gf.design_name}."
@@ -145,7 +145,7 @@ def test_finger_jacobian_is_the_rootfinders_derivative(monkeypatch):
     rootfinder (the optimiser's former finger function), at a light contact
     of the short test grasp."""
     monkeypatch.setenv("DESIGN_COMPILE", "0")     # the formula, not the compiler
-    from design.solve.optimize.finger_load import SIZES, FingerLoad, StageFunctions
+    from design.solvers.optimize.finger_load import SIZES, FingerLoad, StageFunctions
     from tests.design_cases import short_setup
 
     setup = short_setup()
@@ -184,7 +184,7 @@ def test_finger_batch_is_the_stages_one_by_one(monkeypatch):
     again at the same point (the Jacobian after the constraints) solves no
     contact again."""
     monkeypatch.setenv("DESIGN_COMPILE", "0")
-    from design.solve.optimize.finger_load import FingerLoad
+    from design.solvers.optimize.finger_load import FingerLoad
     from tests.design_cases import short_setup
 
     setup = short_setup()
@@ -228,11 +228,11 @@ def test_finger_batch_is_the_stages_one_by_one(monkeypatch):
 
 
 def test_buffered_calls_equal_the_function_s_and_do_not_share_outputs():
-    """design.solve.buffers.Buffered: the same numbers as Function.__call__
+    """design.solvers.buffers.Buffered: the same numbers as Function.__call__
     (column-major matrices), fresh arrays per call (a state kept from one
     call must not change at the next), a sparse output and a wrong input
     size named."""
-    from design.solve.buffers import Buffered
+    from design.solvers.buffers import Buffered
     sparse = small_function()
     with pytest.raises(ValueError, match="small: output 1 is sparse"):
         Buffered(sparse)

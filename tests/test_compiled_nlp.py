@@ -1,4 +1,4 @@
-"""The design NLP's reuse (design/solve/optimize/transcription.py): an NLP
+"""The design NLP's reuse (design/solvers/optimize/transcription.py): an NLP
 solved again with another cap and trust region (DesignNLP.rebound, what the
 design loop does after a rejected candidate) gives to the last bit what a
 new NLP with those bounds gives, and its constraints and Jacobian at a
@@ -9,9 +9,9 @@ contacts); at a new point they are a new NLP's to the contacts' tolerance
 import numpy as np
 import pytest
 
-from design.solve.optimize.schedule import schedule_of
-from design.solve.optimize.transcription import DesignNLP, NLPSettings
-from design.solve.optimize.trust_region import LoopSettings, simulate
+from design.solvers.optimize.schedule import schedule_of
+from design.solvers.optimize.transcription import DesignNLP, NLPSettings
+from design.solvers.optimize.trust_region import LoopSettings, simulate
 from tests.design_cases import sharing_simulations, stiffness_space
 
 #: test_design_solve's settings, so that the session shares the simulation

@@ -8,7 +8,7 @@ import pytest
 from design.physics.beam import Finger
 from design.physics.contact import SIDES, FingerPose, Motion, segment_overlap
 from design.physics.ellipse import Ellipse
-from design.solve.contact import AlgorithmI, AlgorithmII, RobustContact
+from design.solvers.contact import AlgorithmI, AlgorithmII, RobustContact
 from design.reproduce.contact import OMEGA, SPEED, pass_position, scene
 from tests.contact_reference import reference
 from tests.problems import thesis_finger, uniform_finger

@@ -12,8 +12,8 @@ import pytest
 
 from design.physics.contact import SIDES
 from design.physics.ellipse import Ellipse
-from design.solve.contact import RobustContact
-from design.solve.contact.robust import BASE_FRACTION, BASE_REACHED
+from design.solvers.contact import RobustContact
+from design.solvers.contact.robust import BASE_FRACTION, BASE_REACHED
 from tests import prefetch
 from tests.contact_reference import reference
 from tests.problems import entering_poses, thesis_finger

@@ -107,8 +107,8 @@ def test_rule_5_3_counts_the_graspers_finger_sets():
     rule's n defaults to the grasper's sets, so that spacing holds, and the
     same spacing with n = 1 does not."""
     from design.reproduce.grasp import thesis_setup
-    from design.solve.optimize.transcription import Rules, rule_margins
-    from design.solve.optimize.variables import parameters_of, timed_conveyor
+    from design.solvers.optimize.transcription import Rules, rule_margins
+    from design.solvers.optimize.variables import parameters_of, timed_conveyor
 
     setup = thesis_setup(0.0, 0.6)
     setup = replace(setup, conveyor=timed_conveyor(setup.conveyor, None))

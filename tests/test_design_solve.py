@@ -14,10 +14,10 @@ import numpy as np
 import pytest
 
 from design.cli import main
-from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.schedule import schedule_of
-from design.solve.optimize.transcription import DesignNLP, NLPSettings
-from design.solve.optimize.trust_region import (LoopSettings, Outcome, optimise, score,
+from design.solvers.grasp.simulation import simulate_grasp
+from design.solvers.optimize.schedule import schedule_of
+from design.solvers.optimize.transcription import DesignNLP, NLPSettings
+from design.solvers.optimize.trust_region import (LoopSettings, Outcome, optimise, score,
                                                 simulate, verdict, verify)
 from tests.design_cases import sharing_simulations, short_problem_file, stiffness_space
 
@@ -155,7 +155,7 @@ def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch, shared_s
         asked.append(cap)
         raise RuntimeError("no NLP in this test")
 
-    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", no_nlp)
+    monkeypatch.setattr("design.solvers.optimize.trust_region.DesignNLP", no_nlp)
     out = optimise(stiffness_space("upper"), 20.0, LoopSettings(nlp=SETTINGS.nlp, cap_margin=0.2))
     assert asked == pytest.approx([16.0, 18.0, 19.0, 19.5])
     assert [i["error"] for i in out.iterations] == ["no NLP in this test"] * 4
@@ -168,7 +168,7 @@ def test_a_stalled_view_stops_and_a_converging_one_does_not():
     the floor, does not."""
     from types import SimpleNamespace
 
-    from design.solve.optimize.transcription import _Progress
+    from design.solvers.optimize.transcription import _Progress
 
     def stalled(violations, n=15, floor=1e-2):
         fake = SimpleNamespace(stall=(n, floor), history=[{"violation": v} for v in violations])
@@ -192,8 +192,8 @@ def test_a_baseline_that_turns_the_bird_over_is_refused_by_name():
     is the same motion): one simulation, not a second one of the timed belt
     (3.2 s CPU) as the design loop would."""
     from design.reproduce.grasp import thesis_setup
-    from design.solve.optimize.transcription import MAX_PITCH
-    from design.solve.optimize.variables import DesignSpace, Variable, timed_conveyor
+    from design.solvers.optimize.transcription import MAX_PITCH
+    from design.solvers.optimize.variables import DesignSpace, Variable, timed_conveyor
 
     setup = thesis_setup(0.0, 1.6, "hard", start=-0.457,
                          conveyor_file="decelerate_figure_5_10.yaml")

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from design.physics.beam import PointLoad
-from design.solve.effective_ei import THESIS_CALIBRATION, effective_ei, effective_ei_table
+from design.solvers.effective_ei import THESIS_CALIBRATION, effective_ei, effective_ei_table
 from tests.closed_forms import EFFECTIVE_EI_REL, effective_ei as independent
 from tests.problems import HARD_E, table_2_3, thesis_finger, uniform_finger
 

@@ -17,7 +17,7 @@ import yaml
 
 from design.api import fit
 from design.cli import main
-from design.fit.belt import monotone_fit, ramp, ramp_fit
+from design.calibration.belt import monotone_fit, ramp, ramp_fit
 from design.io.grasp_scene import read_conveyor
 from design.io.reader import Reader
 

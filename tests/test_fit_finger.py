@@ -37,11 +37,11 @@ import pytest
 import yaml
 
 from design.cli import main
-from design.fit.convex import CompliancePQ, compliance_scale, fit_compliance, weight_grid
-from design.fit.data import FingerData, Observation
-from design.fit.elastica import elastica_predictions, uniform_fit
-from design.fit.kernel import kernel
-from design.fit.refinement import refine
+from design.calibration.convex import CompliancePQ, compliance_scale, fit_compliance, weight_grid
+from design.calibration.data import FingerData, Observation
+from design.calibration.elastica import elastica_predictions, uniform_fit
+from design.calibration.kernel import kernel
+from design.calibration.refinement import refine
 from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import Stiffness, UniformEI
@@ -323,7 +323,7 @@ def test_large_deflections_are_refined_on_the_elastica_and_the_model_simulates(t
 def test_the_exponential_family_is_recovered_from_its_own_profile():
     """Projecting the thesis's EI(s) (a 1 % band) onto eq. 2.33's family with
     its rates gives back its A, B, C (the projection is exact on the family)."""
-    from design.fit.exponential import project
+    from design.calibration.exponential import project
 
     ei = THESIS.ei(KNOTS)
     got = project(KNOTS, ei, 0.01 * ei, KNOTS <= 0.19, LENGTH, THESIS.E, (THESIS.a, THESIS.b))

@@ -6,8 +6,8 @@ import pytest
 from design.errors import MethodUnsupportedError
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
-from design.solve.beam import solve_beam
-from design.solve.beam.frisch_fay import kl_of, secondary_threshold, solve_root
+from design.solvers.beam import solve_beam
+from design.solvers.beam.frisch_fay import kl_of, secondary_threshold, solve_root
 from tests.problems import table_2_3
 
 UNIT = Finger(1.0, UniformEI(1.0))

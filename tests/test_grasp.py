@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from design.physics.bird import Legs
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import simulate_grasp
 from tests import prefetch
 from tests.problems import thesis_grasp_setup
 
@@ -152,7 +152,7 @@ def test_a_reversal_is_located_just_past_its_crossing_in_few_evaluations():
     to 2 depth/|g'|, and it comes from fewer evaluations than narrowing
     brentq's bracket to 1e-12 s (on a smooth margin, with 1e-11 noise as the
     Newton tolerance leaves on it)."""
-    from design.solve.grasp.integrate import REVERSAL_DEPTH, _locate
+    from design.solvers.grasp.integrate import REVERSAL_DEPTH, _locate
     rng = np.random.default_rng(3)
     calls = []
 

@@ -7,8 +7,8 @@ import pytest
 
 from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs
 from design.physics.grasper import Grasper
-from design.solve.grasp.fingers import FingerForces
-from design.solve.grasp.integrate import Grasp, IntegratorSettings, _local_error, integrate
+from design.solvers.grasp.fingers import FingerForces
+from design.solvers.grasp.integrate import Grasp, IntegratorSettings, _local_error, integrate
 
 MEAN = Bird(0.097, 0.066, 0.057, 1.8, 0.00417, "mean")
 FOOTBALL = Bird(0.122, 0.066, 0.066, 0.425, 0.0016, "football")

@@ -127,7 +127,7 @@ def test_the_straight_fingers_least_level_is_the_sampled_minimum():
     minimum) against the level function sampled densely along the finger:
     equal to the sampled minimum within the sampling error (the parabola's
     curvature times half a sample step squared), never above it."""
-    from design.solve.grasp.fingers import straight_level
+    from design.solvers.grasp.fingers import straight_level
     rng = np.random.default_rng(7)
     for _ in range(200):
         body = Ellipsoid(*rng.uniform(0.03, 0.15, 3), tuple(rng.uniform(-0.1, 0.1, 3)),

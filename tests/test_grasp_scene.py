@@ -133,7 +133,7 @@ def test_a_failed_contact_fails_the_run_and_names_finger_and_time(tmp_path, monk
 
     from design.io.grasp_scene import GraspSettings
     from design.io.scene_writer import grasp_spec, scene_yaml
-    from design.solve.contact.robust import RobustContact
+    from design.solvers.contact.robust import RobustContact
     from tests.design_cases import short_setup
 
     scene = tmp_path / "short.yaml"

@@ -3,7 +3,7 @@
 import numpy as np
 
 from design.reproduce.grasp import MEAN_START, mean_bird_setup
-from design.solve.grasp.fingers import FingerForces
+from design.solvers.grasp.fingers import FingerForces
 
 
 def fingers_of(setup) -> FingerForces:

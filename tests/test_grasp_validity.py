@@ -1,11 +1,11 @@
-"""What a grasp run says about its own validity (design/solve/grasp/validity.py)."""
+"""What a grasp run says about its own validity (design/solvers/grasp/validity.py)."""
 
 from dataclasses import replace
 
 from design.reproduce.grasp import mean_bird_setup
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
-from design.solve.grasp.validity import validity_problems
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import simulate_grasp
+from design.solvers.grasp.validity import validity_problems
 
 
 def short(setup, duration=0.01):

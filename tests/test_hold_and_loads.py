@@ -12,9 +12,9 @@ import pytest
 from design.io.scene import load_scene
 from design.physics.bird import Bird, BirdDynamics, Legs, Loads
 from design.run.grasp import setup_of
-from design.solve.grasp.fingers import FingerForces, FingerState
-from design.solve.grasp.integrate import Record, Trajectory
-from design.solve.grasp.simulation import GraspRun, summarise
+from design.solvers.grasp.fingers import FingerForces, FingerState
+from design.solvers.grasp.integrate import Record, Trajectory
+from design.solvers.grasp.simulation import GraspRun, summarise
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -158,7 +158,7 @@ def test_ctrl_c_stops_design_simulate_on_a_grasp_scene(tmp_path):
 #: (tests/design_cases.py, shared with test_run_status.py), handed over pickled
 QUICK_SIMULATIONS = """
 import pickle
-from design.solve.optimize import trust_region
+from design.solvers.optimize import trust_region
 with open({path!r}, "rb") as f:
     baseline = pickle.load(f)
 trust_region.simulate_grasp = lambda setup, *args, **kwargs: baseline

@@ -1,4 +1,4 @@
-"""The design on the spatial finger model (design/solve/optimize/model_check.py):
+"""The design on the spatial finger model (design/solvers/optimize/model_check.py):
 its runs in the background process are the spatial simulation itself, its
 verdict follows the cap's rule on the spatial baseline, and closing it stops
 a run in progress."""
@@ -15,11 +15,11 @@ import pytest
 from design.io.design_problem import Cap
 from design.io.scene import load_scene
 from design.run.solve import design_space
-from design.solve.grasp.simulation import simulate_grasp
-from design.solve.optimize.model_check import ModelCheck, check_text, compare, spatial_summary
-from design.solve.optimize.population import Member, Population
-from design.solve.optimize.trust_region import LOOP_SIMULATOR
-from design.solve.optimize.variables import DesignSpace
+from design.solvers.grasp.simulation import simulate_grasp
+from design.solvers.optimize.model_check import ModelCheck, check_text, compare, spatial_summary
+from design.solvers.optimize.population import Member, Population
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
+from design.solvers.optimize.variables import DesignSpace
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -44,9 +44,9 @@ def test_the_background_run_is_the_spatial_simulation_and_runs_no_script_twice(t
         f"open({str(marks)!r}, 'a').write('x')\n"
         f"sys.path.insert(0, {str(ROOT)!r})\n"
         "from tests.test_model_check import placed_bird\n"
-        "from design.solve.optimize.model_check import ModelCheck\n"
-        "from design.solve.optimize.population import Population\n"
-        "from design.solve.optimize.trust_region import LOOP_SIMULATOR\n"
+        "from design.solvers.optimize.model_check import ModelCheck\n"
+        "from design.solvers.optimize.population import Population\n"
+        "from design.solvers.optimize.trust_region import LOOP_SIMULATOR\n"
         "space = placed_bird(0.08)\n"
         "with ModelCheck(LOOP_SIMULATOR) as check:\n"
         "    check.submit('baseline', Population.of(space), space.scale(space.base_values))\n"

@@ -1,10 +1,10 @@
-"""The one numpy Newton (design/solve/newton.py): it converges where it should,
+"""The one numpy Newton (design/solvers/newton.py): it converges where it should,
 and every way it can fail comes back as a status with a reason."""
 
 import numpy as np
 import pytest
 
-from design.solve.newton import damped_newton, forward_difference
+from design.solvers.newton import damped_newton, forward_difference
 
 
 def atan_system(x):

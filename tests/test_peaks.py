@@ -1,5 +1,5 @@
 """Finger-force maxima located between the integrator's accepted instants
-(design/solve/grasp/peaks.py): the interpolation on closed forms, and on
+(design/solvers/grasp/peaks.py): the interpolation on closed forms, and on
 the hard-finger mean bird that locating them leaves the integration as it
 was and makes the peak independent of where the steps fall."""
 
@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from design.reproduce.grasp_rows import peak_split
-from design.solve.grasp import peaks
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.peaks import PEAK_RTOL, interpolated_maximum
-from design.solve.grasp.simulation import simulate_grasp
+from design.solvers.grasp import peaks
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.peaks import PEAK_RTOL, interpolated_maximum
+from design.solvers.grasp.simulation import simulate_grasp
 from tests.problems import thesis_grasp_setup
 
 

@@ -1,5 +1,5 @@
-"""Robust design over a population of birds (design/solve/optimize/population.py)
-and the multistart's starts and optima (design/solve/optimize/multistart.py).
+"""Robust design over a population of birds (design/solvers/optimize/population.py)
+and the multistart's starts and optima (design/solvers/optimize/multistart.py).
 
 The population NLP's invariant: birds that are the same bird under other
 names must give the single bird's NLP solution, whatever the aggregate
@@ -17,11 +17,11 @@ import pytest
 
 from design.io.scene import load_scene
 from design.errors import ProblemFileError
-from design.solve.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
-from design.solve.optimize.population import Member, Population, PopulationNLP
-from design.solve.optimize.schedule import schedule_of
-from design.solve.optimize.transcription import DesignNLP, NLPSettings
-from design.solve.optimize.trust_region import LoopSettings, simulate
+from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
+from design.solvers.optimize.population import Member, Population, PopulationNLP
+from design.solvers.optimize.schedule import schedule_of
+from design.solvers.optimize.transcription import DesignNLP, NLPSettings
+from design.solvers.optimize.trust_region import LoopSettings, simulate
 from tests import prefetch
 from tests.design_cases import sharing_simulations, stiffness_space
 

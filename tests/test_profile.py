@@ -1,4 +1,4 @@
-"""Where a design run's time goes (design/solve/optimize/profile.py): the
+"""Where a design run's time goes (design/solvers/optimize/profile.py): the
 profile in result.json and the report accounts for the run's wall time
 phase by phase, sums CasADi's statistics of the NLPs that ran and records
 peak memory.
@@ -19,9 +19,9 @@ import time
 import pytest
 
 from design.cli import main
-from design.solve.optimize.profile import (IPOPT, OPTIMISER, UNACCOUNTED, VIEWS, Profile,
+from design.solvers.optimize.profile import (IPOPT, OPTIMISER, UNACCOUNTED, VIEWS, Profile,
                                            profile_rows)
-from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
 from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
 
 
@@ -34,7 +34,7 @@ def solved(tmp_path_factory):
                               {"groups.upper.stiffness_scale": [0.5, 1.5]},
                               max_iter=2, outer_iterations=1, time_step=0.02)
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr("design.solve.optimize.trust_region.simulate_grasp",
+        patch.setattr("design.solvers.optimize.trust_region.simulate_grasp",
                       lambda *args, **kwargs: run)
         main(["solve", str(path), "--out", str(tmp / "out"), "--quiet"])
     return (json.loads((tmp / "out" / "result.json").read_text()),

@@ -20,10 +20,10 @@ from design.report.design import design_page
 from design.report.grasp_figures import finger_curves
 from design.report.page import write_report
 from design.run import RunOutput
-from design.solve.contact.spatial import Quadric, SpatialContact
-from design.solve.grasp.fingers import FingerState
-from design.solve.optimize.model_check import compare
-from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from design.solvers.contact.spatial import Quadric, SpatialContact
+from design.solvers.grasp.fingers import FingerState
+from design.solvers.optimize.model_check import compare
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
 from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
@@ -166,7 +166,7 @@ DESIGN_RUN = "tests/test_reports.py: the short design solve"
 
 
 class RecordingCheck:
-    """The spatial model check's interface (design/solve/optimize/model_check.py)
+    """The spatial model check's interface (design/solvers/optimize/model_check.py)
     without its spatial runs (12 s of CPU on the short grasp, in a third
     process beside the test process and the prefetch worker): it records the
     designs the run hands it and answers with made-up runs, the optimum's

@@ -20,7 +20,7 @@ from design.report.video import write_video
 from design.report.viewer import animation_html
 from design.run.animation import MAX_FRAMES, STATE, animation_record, frame_states, frame_step
 from design.run.grasp import timeseries
-from design.solve.optimize.trust_region import LOOP_SIMULATOR
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
 from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
 from tests.test_reports import short_scene
 

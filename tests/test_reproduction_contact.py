@@ -17,7 +17,7 @@ from design.reproduce.contact import (CASES, FEM_PASS, OMEGA, SPEED, THESIS_CASE
                                       UNIFORM, pass_angle, pass_position, scene, table_3_1,
                                       thesis_pass)
 from design.reproduce.contact_rows import FORCE_REL, POINT_TOL
-from design.solve.contact import RobustContact
+from design.solvers.contact import RobustContact
 from tests.contact_reference import reference
 
 #: the reference's own error on the contact point (m) and, relative, on the

@@ -1,4 +1,4 @@
-"""The robustness table (design/solve/optimize/robustness.py): each perturbed
+"""The robustness table (design/solvers/optimize/robustness.py): each perturbed
 scene changes the one thing it names, and the optimum beats the baseline
 only where it holds longer, keeps the cap and does not jam."""
 
@@ -11,7 +11,7 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
-from design.solve.optimize.robustness import CASES, robustness_text, scenes, table
+from design.solvers.optimize.robustness import CASES, robustness_text, scenes, table
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -1,4 +1,4 @@
-"""The finger as a spatial rod (design/physics/rod.py, design/solve/beam/rod.py):
+"""The finger as a spatial rod (design/physics/rod.py, design/solvers/beam/rod.py):
 closed forms, the planar elastica as a special case, convergence order and
 equilibrium."""
 
@@ -7,9 +7,9 @@ import pytest
 
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
-from design.solve.beam import solve_beam
-from design.solve.beam.frisch_fay import FrischFay
-from design.solve.beam.rod import solve_rod
+from design.solvers.beam import solve_beam
+from design.solvers.beam.frisch_fay import FrischFay
+from design.solvers.beam.rod import solve_rod
 from tests.problems import thesis_finger, uniform_finger
 
 

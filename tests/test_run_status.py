@@ -12,7 +12,7 @@ import pytest
 
 from design.cli import main
 from design.run.solve import ERROR, FAILED, NO_IMPROVEMENT, VERIFIED, overall_status
-from design.solve.optimize.transcription import DesignNLP, NLPResult
+from design.solvers.optimize.transcription import DesignNLP, NLPResult
 from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
 
 
@@ -24,7 +24,7 @@ def one_run():
 @pytest.fixture
 def problem(tmp_path, one_run, monkeypatch):
     """A design problem on the short grasp whose every simulation is ``one_run``."""
-    monkeypatch.setattr("design.solve.optimize.trust_region.simulate_grasp",
+    monkeypatch.setattr("design.solvers.optimize.trust_region.simulate_grasp",
                         lambda *args, **kwargs: one_run)
     return short_problem_file(tmp_path / "problem.yaml",
                               {"groups.lower.stiffness_scale": [0.5, 2.0]},
@@ -90,8 +90,8 @@ def failing_nlps(how):
 @pytest.mark.parametrize("how", ["raises", "Ipopt error status"])
 def test_every_nlp_failing_is_an_error_not_a_verified_baseline(problem, monkeypatch, capsys,
                                                                 how):
-    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", failing_nlps(how))
-    monkeypatch.setattr("design.solve.optimize.transcription.ca.nlpsol", IpoptEndsOnAnError)
+    monkeypatch.setattr("design.solvers.optimize.trust_region.DesignNLP", failing_nlps(how))
+    monkeypatch.setattr("design.solvers.optimize.transcription.ca.nlpsol", IpoptEndsOnAnError)
     code, result, last, stderr, report, out = solve(problem, capsys)
     assert code == 1
     assert result["status"] == ERROR
@@ -107,7 +107,7 @@ def test_every_nlp_failing_is_an_error_not_a_verified_baseline(problem, monkeypa
 
 def test_no_improvement_is_its_own_status_with_the_baseline_labelled(problem, monkeypatch,
                                                                      capsys):
-    monkeypatch.setattr("design.solve.optimize.trust_region.DesignNLP", NoBetterNLP)
+    monkeypatch.setattr("design.solvers.optimize.trust_region.DesignNLP", NoBetterNLP)
     code, result, last, stderr, report, out = solve(problem, capsys)
     assert code == 0
     assert result["status"] == NO_IMPROVEMENT
@@ -138,7 +138,7 @@ def test_a_claim_the_optimiser_cannot_evaluate_fails_verification_with_a_report(
     """A design off the baseline whose fixed-design NLP does not converge has
     no claim (NaN): the run ends 'failed verification' (exit 1) with its
     report, result.json writing the claim as null, not a traceback."""
-    from design.solve.optimize.trust_region import Outcome, score
+    from design.solvers.optimize.trust_region import Outcome, score
 
     def moved(population, caps, settings, rules, start, progress, anchor=True):
         d0 = population.space.scale(population.space.base_values)
@@ -146,7 +146,7 @@ def test_a_claim_the_optimiser_cannot_evaluate_fails_verification_with_a_report(
                        caps)
 
     monkeypatch.setattr("design.run.solve.optimise", moved)
-    monkeypatch.setattr("design.solve.optimize.trust_region.optimiser_views",
+    monkeypatch.setattr("design.solvers.optimize.trust_region.optimiser_views",
                         lambda *args, **kwargs: ([None], "the fixed-design NLP failed: stalled"))
     code, result, last, stderr, report, out = solve(problem, capsys)
     assert code == 1

@@ -1,4 +1,4 @@
-"""A spatial rod finger against an ellipsoid (design/solve/contact/spatial.py):
+"""A spatial rod finger against an ellipsoid (design/solvers/contact/spatial.py):
 the planar contact as a special case, rotation invariance, the contact
 conditions, friction, and the situations every contact solver must handle."""
 
@@ -9,8 +9,8 @@ from design.physics.beam import Finger
 from design.physics.ellipse import Ellipse
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
-from design.solve.contact import RobustContact
-from design.solve.contact.spatial import FrictionLaw, Quadric, SpatialContact, SpatialState
+from design.solvers.contact import RobustContact
+from design.solvers.contact.spatial import FrictionLaw, Quadric, SpatialContact, SpatialState
 from tests.problems import thesis_finger, uniform_finger
 
 #: semi-axis (m) along the finger frame's z of the ellipsoid built on a planar ellipse

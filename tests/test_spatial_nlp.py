@@ -1,5 +1,5 @@
-"""The optimiser's spatial finger (design/solve/optimize/finger_load.py's
-SpatialStage) against the simulator's (design/solve/grasp/fingers.py's
+"""The optimiser's spatial finger (design/solvers/optimize/finger_load.py's
+SpatialStage) against the simulator's (design/solvers/grasp/fingers.py's
 SpatialFinger): the same contact, load and force from the same state, and
 its explicit Jacobian is CasADi's derivative of the same chain; and the
 design NLP calls it with each node's whole state (the rates set the
@@ -14,12 +14,12 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.solve import design_space
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import SPATIAL_NODES, simulate_grasp
-from design.solve.optimize.schedule import STAGES, schedule_of
-from design.solve.optimize.transcription import DesignNLP, NLPSettings
-from design.solve.optimize.trust_region import LOOP_SIMULATOR
-from design.solve.optimize.variables import DesignSpace, parameters_of
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import SPATIAL_NODES, simulate_grasp
+from design.solvers.optimize.schedule import STAGES, schedule_of
+from design.solvers.optimize.transcription import DesignNLP, NLPSettings
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
+from design.solvers.optimize.variables import DesignSpace, parameters_of
 from tests import prefetch
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -68,7 +68,7 @@ def finger_4a(placed):
     """Finger 4a's NLP function, interpreted (the formula, not the compiler:
     compiling it takes about 60 s on an empty cache), with its inputs and
     the simulator's state at the last record."""
-    from design.solve.optimize.finger_load import FingerLoad
+    from design.solvers.optimize.finger_load import FingerLoad
     setup, run = placed
     i = [gf.name for gf in setup.grasper.fingers].index("4a")
     record = run.trajectory.records[-1]
@@ -105,7 +105,7 @@ def test_the_spatial_jacobian_is_the_rootfinders_derivative(finger_4a, monkeypat
     planar finger's (tests/test_compiled.py; measured 4.8e-13: both solve the
     same contact to its Newton tolerance)."""
     monkeypatch.setenv("DESIGN_COMPILE", "0")     # CasADi's derivative needs the SX
-    from design.solve.optimize.finger_load import SpatialStage, StageFunctions
+    from design.solvers.optimize.finger_load import SpatialStage, StageFunctions
     load, inputs, state, _ = finger_4a
     mode = state.solution.extras["mode"]
     F = load.function(mode)
@@ -175,7 +175,7 @@ def finger_5a_on_the_belt():
     """Finger 5a pressing the placed mean bird while its tip rests on the belt
     (the spatial run to 0.245 s, 3 s CPU: its last record has 5a in mode
     interior+belt at about 17 N), with its NLP function, interpreted."""
-    from design.solve.optimize.finger_load import FingerLoad
+    from design.solvers.optimize.finger_load import FingerLoad
     space = placed_space(0.245)
     setup = space.setup(space.scale(space.base_values))
     run = simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)

@@ -20,8 +20,8 @@ from design.cli import main
 from design.io.scene import load_scene
 from design.report.page import number
 from design.run.grasp import setup_of
-from design.solve.beam import solve_beam
-from design.solve.grasp.integrate import IntegratorSettings
+from design.solvers.beam import solve_beam
+from design.solvers.grasp.integrate import IntegratorSettings
 from design.tradeoff.grasp import shifted, simulate, window
 from design.tradeoff.study import Row, choose, mark_front, relative
 from tests import prefetch

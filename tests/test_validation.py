@@ -18,8 +18,8 @@ from design.io.scene import load_scene
 from design.reproduce.grasp import contact_nodes, football_setup, mean_bird_setup
 from design.reproduce.grasp_rows import passes, peak_family, touched
 from design.run.grasp import setup_of
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import simulate_grasp
 from tests import prefetch
 
 #: keys of this module's runs for the prefetch worker (tests/prefetch.py)

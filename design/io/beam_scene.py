@@ -19,14 +19,14 @@ import numpy as np
 from design.io.fingers import read_finger
 from design.io.reader import Reader, join
 from design.physics.beam import Finger, PointLoad
-from design.solve.beam import DEFAULT_METHOD, METHODS
+from design.solvers.beam import DEFAULT_METHOD, METHODS
 
 
 @dataclass(frozen=True)
 class BeamSolverSettings:
     """Which beam method, and its resolution."""
 
-    #: one of :data:`design.solve.beam.METHODS`
+    #: one of :data:`design.solvers.beam.METHODS`
     method: str = DEFAULT_METHOD
     #: method resolution (intervals, steps or points; None: the method's default)
     nodes: int | None = None

@@ -28,7 +28,7 @@ from design.io.reader import Reader, join
 from design.physics.beam import Finger
 from design.physics.contact import SIDES, FingerPose, Motion
 from design.physics.ellipse import Ellipse
-from design.solve.contact import CONTACT_METHODS, CONTACT_OPTIONS, DEFAULT_CONTACT_METHOD
+from design.solvers.contact import CONTACT_METHODS, CONTACT_OPTIONS, DEFAULT_CONTACT_METHOD
 
 SLIDING = (*SIDES, "auto")
 

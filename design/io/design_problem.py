@@ -17,17 +17,17 @@ bounds, the bruise cap, the design rules and the solver settings.
       birds: [models/birds/small_1_20kg.yaml, {bird: models/birds/large_2_30kg.yaml, weight: 2}]
     multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
     model_check: spatial       # the default: baseline and optimum also run with the spatial
-                               # finger (design/solve/optimize/model_check.py); none: not
+                               # finger (design/solvers/optimize/model_check.py); none: not
     robustness: true           # baseline and optimum also run in perturbed scenes (friction,
                                # drum phase, other birds, stiffness, a slotted pallet:
-                               # design/solve/optimize/robustness.py); default false
+                               # design/solvers/optimize/robustness.py); default false
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}   # beam_intervals: the
                                # finger mesh, by default the scene's contact_nodes
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
-``drum_speed``, ``spacing`` (design/solve/optimize/variables.py).
+``drum_speed``, ``spacing`` (design/solvers/optimize/variables.py).
 """
 
 from __future__ import annotations
@@ -41,13 +41,13 @@ from design.io.files import resolve
 from design.io.grasp_scene import GraspScene, read_bird
 from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
-from design.solve.optimize.finger_load import STAGE_MODELS
-from design.solve.optimize.model_check import CHECK_MODEL
-from design.solve.optimize.policy import SOLVER_KEYS, loop_settings
-from design.solve.optimize.population import AGGREGATES
-from design.solve.optimize.transcription import Rules
-from design.solve.optimize.trust_region import LoopSettings
-from design.solve.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
+from design.solvers.optimize.finger_load import STAGE_MODELS
+from design.solvers.optimize.model_check import CHECK_MODEL
+from design.solvers.optimize.policy import SOLVER_KEYS, loop_settings
+from design.solvers.optimize.population import AGGREGATES
+from design.solvers.optimize.transcription import Rules
+from design.solvers.optimize.trust_region import LoopSettings
+from design.solvers.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
                                              GROUP_FIELDS)
 
 #: starting designs of ``multistart: {}`` (the baseline and seven Sobol points)
@@ -80,7 +80,7 @@ class Cap:
 @dataclass(frozen=True)
 class PopulationSpec:
     """The birds a robust design must hold, their weights (for ``mean``) and
-    how their holds combine (design/solve/optimize/population.py)."""
+    how their holds combine (design/solvers/optimize/population.py)."""
 
     birds: tuple[Bird, ...]
     weights: tuple[float, ...]
@@ -104,17 +104,17 @@ class DesignProblem:
     caps: list[Cap]
     rules: Rules
     #: the solver options as the problem states them (SI; any of
-    #: design/solve/optimize/policy.py's SOLVER_KEYS, the rest default)
+    #: design/solvers/optimize/policy.py's SOLVER_KEYS, the rest default)
     solver: dict
     description: str = ""
     #: several birds (robust design), or None: the scene's bird alone
     population: PopulationSpec | None = None
-    #: the loop from several starting designs (design/solve/optimize/multistart.py)
+    #: the loop from several starting designs (design/solvers/optimize/multistart.py)
     multistart: MultistartSpec = MultistartSpec()
     #: the finger model baseline and optimum are also simulated with, or ``none``
     model_check: str = CHECK_MODEL
     #: baseline and optimum also simulated in the perturbed scenes of
-    #: design/solve/optimize/robustness.py
+    #: design/solvers/optimize/robustness.py
     robustness: bool = False
 
     @property
@@ -124,7 +124,7 @@ class DesignProblem:
     @property
     def settings(self) -> LoopSettings:
         """The settings the design loop runs with: :attr:`solver` under the
-        solve layer's policy (:func:`design.solve.optimize.policy.loop_settings`)."""
+        solve layer's policy (:func:`design.solvers.optimize.policy.loop_settings`)."""
         return loop_settings(self.solver, self.scene.settings)
 
 
@@ -235,7 +235,7 @@ def _baseline_values(scene: GraspScene) -> dict[str, float]:
     """The scene's own value of every design variable (SI), except the belt's
     deceleration start, which a simulation decides."""
     from design.run.grasp import setup_of
-    from design.solve.optimize.variables import parameters_of, timed_conveyor
+    from design.solvers.optimize.variables import parameters_of, timed_conveyor
     setup = setup_of(scene)
     values = parameters_of(replace(setup, conveyor=timed_conveyor(setup.conveyor, 0.0)))
     values.pop("conveyor.start_time")
@@ -337,7 +337,7 @@ SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
 
 def _solver(reader: Reader, value: object) -> dict | None:
     """The solver options the problem states, validated, in SI; the solve
-    layer decides the rest (design/solve/optimize/policy.py)."""
+    layer decides the rest (design/solvers/optimize/policy.py)."""
     spec = reader.mapping(value, "solver", optional=SOLVER_KEYS)
     if spec is None:
         return None

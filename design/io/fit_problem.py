@@ -46,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from design.fit.data import FingerData, Observation
+from design.calibration.data import FingerData, Observation
 from design.io.fingers import read_finger
 from design.io.files import resolve, searched
 from design.io.reader import Reader, interval

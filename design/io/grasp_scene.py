@@ -33,9 +33,9 @@ from design.physics.belt import Belt
 from design.physics.bird import Bird, Conveyor, Legs
 from design.physics.grasper import GraspFinger, Grasper
 from design.physics.kinematics import FingerMount
-from design.solve.grasp.fingers import FINGER_MODELS
-from design.solve.grasp.integrate import INTEGRATORS, STEPPERS, IntegratorSettings
-from design.solve.grasp.simulation import GraspSetup
+from design.solvers.grasp.fingers import FINGER_MODELS
+from design.solvers.grasp.integrate import INTEGRATORS, STEPPERS, IntegratorSettings
+from design.solvers.grasp.simulation import GraspSetup
 
 _MODEL_KEYS = ("kind", "name", "description", "source", "note")
 

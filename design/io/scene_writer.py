@@ -7,8 +7,8 @@ import yaml
 
 from design.io.grasp_scene import GraspSettings
 from design.physics.beam import Finger
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import GraspSetup
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import GraspSetup
 
 
 def finger_spec(finger: Finger) -> dict:

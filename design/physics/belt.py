@@ -2,7 +2,7 @@
 
 The belt's surface is the plane Z = 0 of the world frame (MODEL.md,
 "Frames"), moving along X at the conveyor's speed. A finger whose tip would
-pass below it presses on it instead (design/solve/contact/spatial_belt.py).
+pass below it presses on it instead (design/solvers/contact/spatial_belt.py).
 
 By default the belt is solid and wider than any finger reaches. A scene can
 say otherwise: ``width`` (m) makes it a strip |Y| ≤ width / 2, beside

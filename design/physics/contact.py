@@ -93,7 +93,7 @@ class ContactSolution:
     extras: dict = field(default_factory=dict)
     #: the finger's force on the belt in its plane (N, finger frame; None: not
     #: on the belt), its normal part, the tip where it acts, and how far the
-    #: finger's deepest point lies below the belt (m) (design/solve/contact/
+    #: finger's deepest point lies below the belt (m) (design/solvers/contact/
     #: planar_belt.py)
     belt_force: np.ndarray | None = None
     belt_normal_force: float = 0.0

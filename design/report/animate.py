@@ -73,7 +73,7 @@ def animate(result_dir: str | Path, out: str | Path | None = None, speed: float 
     from design.report.grasp import animation_view
     from design.report.page import Page
     from design.report.video import ffmpeg_available, write_video
-    from design.solve.grasp.fingers import ContactFailed
+    from design.solvers.grasp.fingers import ContactFailed
 
     result, source = read_record(Path(result_dir))
     path = output_path(Path(result_dir), None if out is None else str(out), ffmpeg_available())

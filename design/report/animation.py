@@ -2,7 +2,7 @@
 
 A run's result keeps the bird's state at evenly spaced frame times
 (design/run/animation.py). At each frame every finger's contact is solved
-at that state (:class:`~design.solve.grasp.fingers.FingerForces`, committed
+at that state (:class:`~design.solvers.grasp.fingers.FingerForces`, committed
 frame by frame in time order, each continued from the frame before), which
 gives its deflected shape, its force on the bird and the contact point.
 
@@ -19,8 +19,8 @@ import numpy as np
 from design.physics.kinematics import MIRROR, Ellipsoid, rot_y
 from design.report.grasp_figures import MM, drum_profile, finger_curves
 from design.run.animation import STATE
-from design.solve.grasp.fingers import FingerForces
-from design.solve.grasp.simulation import GraspSetup
+from design.solvers.grasp.fingers import FingerForces
+from design.solvers.grasp.simulation import GraspSetup
 
 #: points kept of a deflected finger's shape (base and tip among them)
 FINGER_POINTS = 12
@@ -72,7 +72,7 @@ def animated_runs(record: dict) -> list[RunFrames]:
     set up from its scene and its fingers solved at every frame
     (:func:`solve_frames`). Raises
     :class:`~design.errors.ProblemFileError` for a scene that does not read,
-    :class:`~design.solve.grasp.fingers.ContactFailed` for a contact that
+    :class:`~design.solvers.grasp.fingers.ContactFailed` for a contact that
     cannot be solved."""
     from design.io.scene import load_scene
     from design.run.grasp import setup_of
@@ -90,7 +90,7 @@ def solve_frames(label: str, setup: GraspSetup, contact_nodes: int, states: dict
     """Every finger's contact solved at each frame's state (``states``: a
     :func:`~design.run.animation.frame_states` dict), in time order, each
     continued from the frame before. Raises
-    :class:`~design.solve.grasp.fingers.ContactFailed` where a contact
+    :class:`~design.solvers.grasp.fingers.ContactFailed` where a contact
     cannot be solved."""
     forces = FingerForces(setup.grasper, setup.bird, setup.drum_speed, setup.finger_friction,
                           intervals=contact_nodes, model=setup.finger_model)

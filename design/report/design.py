@@ -9,11 +9,11 @@ from design.report.grasp import (animation_section, grasp_figures, reproduce_sec
                                  summary_rows)
 from design.report.display import shown
 from design.report.page import Page
-from design.solve.grasp.simulation import GraspRun
-from design.solve.optimize.model_check import check_text
-from design.solve.optimize.robustness import robustness_text
-from design.solve.optimize.profile import profile_rows
-from design.solve.optimize.variables import units
+from design.solvers.grasp.simulation import GraspRun
+from design.solvers.optimize.model_check import check_text
+from design.solvers.optimize.robustness import robustness_text
+from design.solvers.optimize.profile import profile_rows
+from design.solvers.optimize.variables import units
 
 
 #: how the report names a finger model
@@ -173,7 +173,7 @@ def model_check_section(page: Page, check: dict) -> None:
 
 
 def robustness_section(page: Page, robust: dict) -> None:
-    """Baseline and optimum in the perturbed scenes (design/solve/optimize/robustness.py)."""
+    """Baseline and optimum in the perturbed scenes (design/solvers/optimize/robustness.py)."""
     page.section("Robustness: what the problem does not know", "robustness")
     page.text(f"{robustness_text(robust)[0].upper()}{robustness_text(robust)[1:]} (target: "
               f"{robust['target_share']:.0%}). Each scene changes one thing the design problem "

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.figure import Figure
 
-from design.fit.convex import FLAG_LIMIT
+from design.calibration.convex import FLAG_LIMIT
 from design.report.page import Page
 
 MM = 1e3

@@ -8,7 +8,7 @@ from design.report import grasp_figures as gf
 from design.report.display import degrees, shown
 from design.report.page import Page
 from design.report.animation import ARROW_MM_PER_N
-from design.solve.grasp.simulation import GraspRun
+from design.solvers.grasp.simulation import GraspRun
 
 
 def summary_rows(run: GraspRun, label: str = "") -> list[dict]:
@@ -36,7 +36,7 @@ def animation_section(page: Page, result: dict) -> None:
     solved, the reason instead."""
     from design.errors import ProblemFileError
     from design.report.animation import animated_runs
-    from design.solve.grasp.fingers import ContactFailed
+    from design.solvers.grasp.fingers import ContactFailed
 
     page.section("Animation", "animation")
     try:

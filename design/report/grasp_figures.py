@@ -15,8 +15,8 @@ from matplotlib.patches import Polygon
 from matplotlib.patches import Ellipse as EllipsePatch
 
 from design.physics.contact import ContactSolution
-from design.solve.contact.spatial import SpatialSolution
-from design.solve.grasp.simulation import GraspRun, GraspSetup
+from design.solvers.contact.spatial import SpatialSolution
+from design.solvers.grasp.simulation import GraspRun, GraspSetup
 
 MM = 1e3
 #: height (mm of the side view) kept above the birds for each key instant's label

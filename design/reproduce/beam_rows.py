@@ -17,8 +17,8 @@ from design.physics.beam import BeamSolution, Finger, PointLoad
 from design.reproduce.grasp import load_model
 from design.reproduce.figures import beam_figure, effective_ei_figure
 from design.reproduce.rows import OWN_REFERENCE, CaseFailed, Row, Section, claim, compare
-from design.solve.beam import solve_beam
-from design.solve.effective_ei import EffectiveEI, effective_ei, effective_ei_table
+from design.solvers.beam import solve_beam
+from design.solvers.effective_ei import EffectiveEI, effective_ei, effective_ei_table
 
 #: Table 2-1's load-point deflection (m) from the thesis's closed form (eqs.
 #: 2.9-2.12, Figure 2-2's solid line) to 6 digits: the thesis prints no number

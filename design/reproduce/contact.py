@@ -18,8 +18,8 @@ from design.physics.contact import ContactSolution, FingerPose, Motion
 from design.physics.ellipse import Ellipse
 from design.physics.stiffness import UniformEI
 from design.reproduce.grasp import load_model
-from design.solve.contact import AlgorithmI, AlgorithmII, RobustContact
-from design.solve.effective_ei import effective_ei
+from design.solvers.contact import AlgorithmI, AlgorithmII, RobustContact
+from design.solvers.effective_ei import effective_ei
 
 #: the thesis's soft finger: its I(s) from models/fingers/ (no other rigidity enters the plane)
 SOFT = Finger(0.203, load_model(read_finger, "fingers", "thesis_nonuniform_soft.yaml").stiffness,

@@ -13,7 +13,7 @@ from design.io.grasp_scene import GraspSettings, read_bird, read_conveyor, read_
 from design.io.reader import Reader
 from design.physics.bird import Conveyor, Legs, belt_motion
 from design.physics.belt import Belt
-from design.solve.grasp.simulation import SPATIAL_NODES, GraspSetup
+from design.solvers.grasp.simulation import SPATIAL_NODES, GraspSetup
 
 MODELS = TOOLKIT_ROOT / "models"
 OMEGA = 20 * 2 * np.pi / 60
@@ -21,7 +21,7 @@ OMEGA = 20 * 2 * np.pi / 60
 MEAN_START, FOOTBALL_START, SIZES_START = -0.075, -0.305, -0.381
 #: the finger model the chapter V comparisons use: the bird's surface normal
 #: at the contacts lies up to 0.8-0.97 along the fingers' stiff axes, beyond
-#: the planar model's limit (design/solve/grasp/validity.py)
+#: the planar model's limit (design/solvers/grasp/validity.py)
 VALIDATION_MODEL = "spatial"
 #: Table 5-3's 0.6 s from X0 (Figures 5-5 to 5-9: -0.075 to +0.15 m); the
 #: football's one and a half drum cycles of video (§5.3)
@@ -170,8 +170,8 @@ def simulate_all(setups: dict[str, GraspSetup], progress=None,
                  budget: float | None = None) -> dict:
     """Each setup simulated (GraspRun each, by name), each within ``budget`` s
     of wall time if given; ``progress(message)`` is called before each run."""
-    from design.solve.grasp.integrate import IntegratorSettings
-    from design.solve.grasp.simulation import simulate_grasp
+    from design.solvers.grasp.integrate import IntegratorSettings
+    from design.solvers.grasp.simulation import simulate_grasp
 
     runs = {}
     for k, (name, setup) in enumerate(setups.items(), 1):

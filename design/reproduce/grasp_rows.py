@@ -28,8 +28,8 @@ from design.reproduce.grasp import (SIZES_START, football_setup, mean_bird_setup
                                     sizes_setup, slotted)
 from design.reproduce.rows import (THESIS_MEASUREMENT, Row, Section, claim, compare,
                                    context)
-from design.solve.grasp.simulation import GraspRun
-from design.solve.grasp.validity import validity_problems
+from design.solvers.grasp.simulation import GraspRun
+from design.solvers.grasp.validity import validity_problems
 
 TITLE = "Chapter V: grasp simulations (Figures 5-5 to 5-20)"
 HARD, SOFT, CONSTANT = ("mean bird, hard lower fingers", "mean bird, soft lower fingers",

@@ -11,7 +11,7 @@ from design import __version__
 from design.io.beam_scene import BeamScene
 from design.physics.beam import BeamSolution
 from design.run import Progress, RunOutput
-from design.solve.beam import make_method
+from design.solvers.beam import make_method
 
 
 def whole_fingers(sols: Sequence[BeamSolution], length: float) -> list[dict]:

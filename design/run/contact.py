@@ -10,7 +10,7 @@ from design import __version__
 from design.io.contact_scene import ContactScene
 from design.physics.contact import ContactSolution
 from design.run import Progress, RunOutput
-from design.solve.contact import make_contact_solver
+from design.solvers.contact import make_contact_solver
 
 
 def case_dict(sol: ContactSolution, obj) -> dict:

@@ -10,12 +10,12 @@ import numpy as np
 import yaml
 
 from design import __version__
-from design.fit.convex import BAND_Z, FLAG_LIMIT, SOLVER, ProfileFit, fit_compliance
-from design.fit.data import QUANTITIES, FingerData
-from design.fit.elastica import UniformFit, elastica_predictions, uniform_fit
-from design.fit.exponential import project
-from design.fit.kernel import KnotCompliance, kernel
-from design.fit.refinement import Refinement, refine
+from design.calibration.convex import BAND_Z, FLAG_LIMIT, SOLVER, ProfileFit, fit_compliance
+from design.calibration.data import QUANTITIES, FingerData
+from design.calibration.elastica import UniformFit, elastica_predictions, uniform_fit
+from design.calibration.exponential import project
+from design.calibration.kernel import KnotCompliance, kernel
+from design.calibration.refinement import Refinement, refine
 from design.io.fingers import read_finger
 from design.io.fit_problem import FingerFitProblem
 from design.io.reader import Reader

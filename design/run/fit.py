@@ -8,8 +8,8 @@ import numpy as np
 import yaml
 
 from design import __version__
-from design.fit import belt as belt_fit
-from design.fit.convex import SOLVER
+from design.calibration import belt as belt_fit
+from design.calibration.convex import SOLVER
 from design.io.fit_problem import BeltFitProblem
 from design.io.grasp_scene import read_conveyor
 from design.io.reader import Reader

@@ -11,8 +11,8 @@ from design.io.grasp_scene import GraspScene
 from design.io.scene_writer import grasp_spec
 from design.run import Progress, RunOutput
 from design.run.animation import animation_record
-from design.solve.grasp.simulation import GraspRun, GraspSetup, simulate_grasp
-from design.solve.grasp.validity import validity_problems
+from design.solvers.grasp.simulation import GraspRun, GraspSetup, simulate_grasp
+from design.solvers.grasp.validity import validity_problems
 
 
 def setup_of(scene: GraspScene) -> GraspSetup:

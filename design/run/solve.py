@@ -10,7 +10,7 @@ the design breaks the cap; ``error`` (1), the optimiser could not work
 and Ctrl-C (130) write no result.
 
 result.json's ``profile`` says where the run's time went (wall time per
-phase, Ipopt's function evaluations, peak memory: design/solve/optimize/profile.py).
+phase, Ipopt's function evaluations, peak memory: design/solvers/optimize/profile.py).
 """
 
 from __future__ import annotations
@@ -33,21 +33,21 @@ from design.run import Progress, RunOutput
 from design.run.animation import animation_record
 from design.result import Status
 from design.run.grasp import setup_of, timeseries
-from design.solve.grasp.simulation import simulate_grasp
-from design.solve.reproducible import numerics, one_blas_thread
-from design.solve.optimize import robustness
-from design.solve.optimize.robustness import robustness_text
-from design.solve.optimize.model_check import BASELINE, ModelCheck, check_text
-from design.solve.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
+from design.solvers.grasp.simulation import simulate_grasp
+from design.solvers.reproducible import numerics, one_blas_thread
+from design.solvers.optimize import robustness
+from design.solvers.optimize.robustness import robustness_text
+from design.solvers.optimize.model_check import BASELINE, ModelCheck, check_text
+from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
-from design.solve.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
+from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
-from design.solve.optimize.population import Member, Population
-from design.solve.optimize.transcription import rule_margins
-from design.solve.optimize.trust_region import (CAP_TOLERANCE, Outcome, Scored, caps_text,
+from design.solvers.optimize.population import Member, Population
+from design.solvers.optimize.transcription import rule_margins
+from design.solvers.optimize.trust_region import (CAP_TOLERANCE, Outcome, Scored, caps_text,
                                                 caps_value, certify, optimise,
                                                 population_verdict, verify)
-from design.solve.optimize.variables import (DesignSpace, Variable, parameters_of,
+from design.solvers.optimize.variables import (DesignSpace, Variable, parameters_of,
                                              timed_conveyor)
 from design.study.cases import FAILED as CASE_FAILED
 from design.study.cases import Case, StudyOptions
@@ -101,7 +101,7 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     process (``check``).
     The cases run through design/study (``study``: where, and the case
     store); a study of one chain runs in this process. Every BLAS runs one
-    thread (design/solve/reproducible.py): the same answer on any machine."""
+    thread (design/solvers/reproducible.py): the same answer on any machine."""
     background = problem.model_check != "none" or problem.robustness
     with one_blas_thread(), ModelCheck(problem.settings.simulator) if background \
             else nullcontext() as check:
@@ -346,7 +346,7 @@ def _verified(population: Population, key: str, result: dict, settings, profile:
 def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[str],
                        results: dict) -> dict:
     """The starts of one cap and the distinct optima they reached
-    (design/solve/optimize/multistart.py says when two are one)."""
+    (design/solvers/optimize/multistart.py says when two are one)."""
     rows = [{"start": results[key].get("start_index", i), "case": key,
              "status": results[key]["status"], "message": results[key]["message"],
              "verified_hold_time_s": results[key]["verification"]["hold_time_s"],

@@ -17,7 +17,7 @@ measures the overhead; docs/performance.md).
 
 Worker processes compiling the same CasADi function at the same time is
 safe: each builds in its own temporary folder and moves the library into
-the cache with ``os.replace`` (design/solve/compiled.py), so a process
+the cache with ``os.replace`` (design/solvers/compiled.py), so a process
 finds no library or a whole one, and one already loaded keeps its copy.
 """
 

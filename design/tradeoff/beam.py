@@ -16,7 +16,7 @@ import numpy as np
 from design.io.beam_scene import BeamScene
 from design.physics.beam import BeamSolution, Finger, PointLoad
 from design.run import Progress
-from design.solve.beam import DEFAULT_METHOD, METHODS, solve_beam
+from design.solvers.beam import DEFAULT_METHOD, METHODS, solve_beam
 from design.tradeoff.study import Row, Study, relative, timed
 
 #: resolutions (``nodes``) per method; None: the method's default

@@ -18,7 +18,7 @@ import numpy as np
 
 from design.io.contact_scene import ContactScene
 from design.run import Progress
-from design.solve.contact import CONTACT_METHODS, DEFAULT_CONTACT_METHOD, make_contact_solver
+from design.solvers.contact import CONTACT_METHODS, DEFAULT_CONTACT_METHOD, make_contact_solver
 from design.tradeoff.study import Row, Study, relative, timed
 
 #: method -> (its resolution option, values studied, values studied with --quick)

@@ -18,8 +18,8 @@ from design.io.grasp_scene import GraspScene
 from design.reproduce.grasp import advanced
 from design.run import Progress
 from design.run.grasp import setup_of
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import GraspSetup, setup_reach_windows, simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import GraspSetup, setup_reach_windows, simulate_grasp
 from design.tradeoff.study import Row, Study, relative
 
 DEFAULT = IntegratorSettings()

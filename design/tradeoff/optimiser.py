@@ -1,9 +1,9 @@
 """Design level: the optimiser's time grid, on the problem's baseline design.
 
 For each grid step, the fixed-design NLP on the baseline's own simulated
-schedule (:func:`~design.solve.optimize.trust_region.optimiser_view`, the
+schedule (:func:`~design.solvers.optimize.trust_region.optimiser_view`, the
 number the optimiser would claim for the design) against the independent
-simulation at 4x finer resolution (:func:`~design.solve.optimize.trust_region.verify`).
+simulation at 4x finer resolution (:func:`~design.solvers.optimize.trust_region.verify`).
 Error: the hold time (s), relative. Wall time: building and solving that NLP
 (the baseline's simulation, which every grid starts from, is common to all
 and reported apart). Steps studied: twice the toolkit's default, the
@@ -19,8 +19,8 @@ from dataclasses import replace
 from design.io.design_problem import DesignProblem
 from design.run import Progress
 from design.run.solve import design_space
-from design.solve.optimize.transcription import NLPSettings
-from design.solve.optimize.trust_region import (VIEW_FEASIBLE, feasible, optimiser_view,
+from design.solvers.optimize.transcription import NLPSettings
+from design.solvers.optimize.trust_region import (VIEW_FEASIBLE, feasible, optimiser_view,
                                                 simulate, verify)
 from design.tradeoff.study import Row, Study, relative
 

@@ -23,8 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
-from design.fit.data import FingerData, Observation
-from design.fit.elastica import elastica_predictions
+from design.calibration.data import FingerData, Observation
+from design.calibration.elastica import elastica_predictions
 from design.io.fingers import read_finger
 from design.physics.beam import PointLoad
 from design.physics.bird import belt_motion

@@ -26,8 +26,8 @@ from design.reproduce.grasp import (FOOTBALL_START, SIZES_START, contact_nodes, 
                                     mean_bird_setup)
 from design.reproduce.grasp_rows import (DENSE, back_off, family_peaks, impulse_share, passes,
                                          touching, x_end, x_impulse)
-from design.solve.grasp.integrate import IntegratorSettings
-from design.solve.grasp.simulation import GraspSetup, simulate_grasp
+from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.grasp.simulation import GraspSetup, simulate_grasp
 from design.tradeoff.grasp import CASES as TRADEOFF_CASES
 from study_output import parser as study_parser, write_rows
 

@@ -1,0 +1,356 @@
+"""A finger against the bird and the belt: continuation with contact events.
+
+What both finger models share (design/solvers/contact/spatial_belt.py for the
+rod, planar_belt.py for the thesis's planar finger). A finger that can reach
+the belt is solved here; every other finger by its model's bird-only solver.
+The finger's state is one of six modes: ``free`` (straight, unloaded), the
+bird-only ``interior`` and ``tip``, and the belt modes ``belt``,
+``tip+belt`` and ``interior+belt``.
+
+From a solved state the bird, the belt and both friction laws are moved to
+their new values in steps that halve on failure and double on success
+(first the geometry under the old laws, then the laws, as the bird-only
+solvers do). After every step the contacts are checked:
+
+* a contact whose normal force would pull lets go;
+* the tip passing below the belt, or the finger entering the bird, starts a
+  contact;
+* the bird's contact point reaching the tip, or the tip turning tangent to
+  the bird, switches between interior and tip contact.
+
+A contact starts where it should, not a step late: the step is shortened
+until the crossing is within :data:`EVENT_DEPTH` (or the step within
+:data:`EVENT_STEP`), the mode is switched there and the solve repeated in
+the new mode. When the continued state cannot be followed (a fold), the
+finger is solved afresh from the straight finger, with the bird and the
+belt brought in from first touch.
+
+A point of the finger below the belt other than the tip (the finger lying
+on it) is outside the model: it is reported, not corrected.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from design.solvers.buffers import Buffered
+from design.solvers.contact.robust import BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS
+from design.solvers.contact.spatial import CHORD_ITERATIONS
+
+#: a contact event is located to within this penetration (m) ...
+EVENT_DEPTH = 1e-8
+#: ... or this fraction of the continuation step
+EVENT_STEP = 1e-6
+#: a first touch of the bird found in one mode's discretisation may pull in the
+#: contact mode's, which puts the surface a few micrometres elsewhere: the
+#: finger then grazes the bird, without force, until it is this far (m) inside
+GRAZE_DEPTH = 2e-5
+#: the finger's modes that touch the bird, and those that touch the belt
+BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
+BELT_MODES = ("belt", "tip+belt", "interior+belt")
+
+
+@dataclass(frozen=True)
+class Plane:
+    """The belt in a finger frame: n·r = e, n its upward unit normal (3,
+    spatial; (2,) in the planar finger's bending plane), e in m."""
+
+    normal: np.ndarray
+    offset: float
+
+    def level(self, pts: np.ndarray) -> np.ndarray:
+        """Height above the belt (m) of points (dim, n); < 0 below it."""
+        return self.normal @ pts - self.offset
+
+    @property
+    def params(self) -> np.ndarray:
+        return np.concatenate([self.normal, [self.offset]])
+
+    @staticmethod
+    def from_params(p: np.ndarray) -> "Plane":
+        n = np.asarray(p[:-1], float)
+        size = np.linalg.norm(n)
+        return Plane(n / size, float(p[-1]) / size)
+
+    def lowered_to(self, point: np.ndarray) -> "Plane":
+        """The same plane moved down, if need be, to just below ``point``."""
+        return Plane(self.normal, min(self.offset, float(self.normal @ point) - EVENT_DEPTH))
+
+
+@dataclass(frozen=True)
+class Belted:
+    """A finger's state against the bird and the belt: mode, unknowns (None
+    when ``free``), the bird's parameters in the model's form (None: out of
+    reach) and its friction's, the belt and its friction law's parameters,
+    and the post values (the model's belt layout; None when ``free``)."""
+
+    mode: str
+    z: np.ndarray | None
+    bird: np.ndarray | None
+    friction: np.ndarray
+    plane: Plane
+    belt: np.ndarray
+    post: np.ndarray | None = None
+    #: the share of the last friction change carried (below 1: sticking)
+    held: float = 1.0
+    #: planar: the side the bird bends the finger to (+1: towards +y)
+    side: int = 0
+    #: the mode's residual Jacobian inverted at z (for the chord method; None:
+    #: not computed)
+    inverse: np.ndarray | None = None
+    #: how far (m) the finger may enter the bird before a contact is tried
+    #: (GRAZE_DEPTH after a first touch that would pull, else 0)
+    graze: float = 0.0
+
+
+class BeltedContact:
+    """The continuation of :class:`Belted` states; a finger model supplies the
+    equations and the geometry (the methods that raise NotImplementedError).
+
+    Attributes
+    ----------
+    length : float
+        The finger's length (m).
+    n_bird : int
+        The size of the bird's parameters.
+    max_steps : int
+    """
+
+    length: float
+    n_bird: int
+    max_steps: int = 400
+
+    def __init__(self):
+        #: Newton solves of the last :meth:`continued`
+        self.newton_iterations = 0
+        self._calls: dict = {}
+
+    def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
+        """The state at ``target``'s bird, belt and laws, continued from
+        ``previous`` (its mode and unknowns are ignored), else afresh; the
+        message says what happened on the way."""
+        self.newton_iterations = 0
+        state, msg = None, ""
+        if previous is not None and (target.bird is not None or previous.bird is None):
+            state, msg = self._follow(previous, target)
+        if state is not None:
+            return state, msg
+        fresh, msg2 = self._follow(self.free(target), target)
+        if fresh is None:
+            return None, msg2 if not msg else f"{msg}; afresh: {msg2}"
+        if previous is not None:
+            msg = f"continued equilibrium lost ({msg}); snapped to the one found from " \
+                  f"first touch" if msg else ""
+        return fresh, msg
+
+    def lowered(self, state: Belted) -> Belted:
+        """A solved bird-only state (mode, z, bird, friction, belt) with the
+        belt lowered to its tip: the belt then comes in from first touch."""
+        post = self.calls(state.mode)[1](state.z, self.q(state))[0].ravel()
+        solved = self.solved(state, post)
+        plane = state.plane.lowered_to(self.tip(solved))
+        return self.solved(replace(solved, plane=plane), post)
+
+    # ------------------------------------------------------- continuation
+    def _params(self, state: Belted) -> np.ndarray:
+        bird = np.zeros(self.n_bird) if state.bird is None else state.bird
+        return np.concatenate([bird, state.friction, state.plane.params, state.belt])
+
+    def _moved(self, state: Belted, p: np.ndarray) -> Belted:
+        nb, nf, nd = self.n_bird, state.friction.size, state.plane.params.size
+        bird = None if state.bird is None else p[:nb]
+        return replace(state, bird=bird, friction=p[nb:nb + nf],
+                       plane=Plane.from_params(p[nb + nf:nb + nf + nd]), belt=p[nb + nf + nd:])
+
+    def _follow(self, state: Belted, target: Belted) -> tuple[Belted | None, str]:
+        """Continue ``state`` to ``target``: the usual short step, geometry and
+        friction in one solve; else the geometry under the state's own
+        friction, then the friction (where the equilibrium ends before, a
+        fold, the contact sticks at the last one: ``held`` < 1)."""
+        if state.bird is None and target.bird is not None:
+            state = replace(state, bird=target.bird)
+        whole = replace(state, bird=target.bird, plane=target.plane, friction=target.friction,
+                        belt=target.belt)
+        new = self._step(state, whole, 1.0)
+        if isinstance(new, Belted):
+            return replace(new, held=1.0), ""
+        geometry = replace(state, bird=target.bird, plane=target.plane)
+        state, msg = self._path(state, self._params(geometry), exact=True)
+        if state is None:
+            return None, msg
+        laws = replace(state, friction=target.friction, belt=target.belt)
+        return self._path(state, self._params(laws), exact=False)
+
+    def _path(self, state: Belted, end: np.ndarray, exact: bool) -> tuple[Belted | None, str]:
+        """From ``state`` to the parameters ``end`` in adaptive steps, with
+        contact events. ``exact`` false: stop at the last equilibrium before
+        a fold (``held`` the share carried)."""
+        start = self._params(state)
+        if np.array_equal(start, end):
+            return state, ""
+        t, h = 0.0, 1.0
+        for _ in range(self.max_steps):
+            if t >= 1.0:
+                return replace(state, held=1.0), ""
+            t_new = min(1.0, t + h)
+            new = self._step(state, self._moved(state, start + t_new * (end - start)), h)
+            if isinstance(new, Belted):
+                state, t, h = new, t_new, min(2 * h, 1.0)
+                continue
+            if new == "base":
+                return None, BASE_REACHED
+            if isinstance(new, tuple):
+                # a contact starts inside the step, ``depth`` deep at its end: aim
+                # just past the crossing, where the depth, near linear in the
+                # step, passes EVENT_DEPTH / 2 (a secant from the clearance now)
+                _, kind, depth = new
+                before = self.excess(state, kind)
+                h *= (-before + EVENT_DEPTH / 2) / (depth - before) if before < 0.0 else 0.5
+                continue
+            h /= 2
+            if h < 1e-7:
+                if exact:
+                    return None, f"continuation stalled at {t:.6f} of the step"
+                return replace(state, held=t), ""
+        return None, f"no convergence in {self.max_steps} continuation steps"
+
+    def _step(self, state: Belted, at: Belted, h: float):
+        """Solve at the parameters of ``at`` from ``state`` (a step of relative
+        size h): the new state; None (shorten the step: Newton failed);
+        ("locate", kind, depth) (a contact starts inside it, ``depth`` m deep
+        at its end: shorten it to where it starts); ``base``."""
+        mode, z = state.mode, state.z
+        touched = None
+        for _ in range(4):
+            new = self._newton(replace(at, mode=mode, z=z))
+            if new is None:
+                return None
+            if new.graze > 0.0 and self.depth(new, "bird") < 0.0:
+                new = replace(new, graze=0.0)              # clear of the bird again
+            event = self.event(new)
+            if event is None:
+                return new
+            kind, depth = event
+            if kind == "base":
+                return "base"
+            if kind == "release-bird" and touched is not None:
+                return replace(touched, graze=GRAZE_DEPTH)  # a first touch that pulls
+            if depth > EVENT_DEPTH and h > EVENT_STEP and kind in ("bird", "belt"):
+                return "locate", kind, depth
+            switched = self.switch(new, kind)
+            if switched is None:
+                return None
+            touched = new if kind == "bird" else None
+            mode, z = switched.mode, switched.z
+            at = replace(at, side=switched.side, inverse=None)
+        return None
+
+    def _newton(self, state: Belted) -> Belted | None:
+        """Newton in the state's mode at its parameters from its z; None when
+        it does not converge within MAX_STEP_ITERATIONS."""
+        if state.mode == "free":
+            return state
+        newton, post = self.calls(state.mode)[:2]
+        q = self.q(state)
+        z = None if state.inverse is None else self.transcription(state.mode).chord.solve(
+            state.z, q, state.inverse, self.tolerance, CHORD_ITERATIONS)
+        if z is None:
+            z = newton(state.z, q)[0].ravel()
+        self.newton_iterations += 1
+        post, resid = (v.ravel() for v in post(z, q))
+        if not (np.isfinite(resid[0]) and resid[0] < 1e-8):
+            return None
+        return self.solved(replace(state, z=z, inverse=None), post)
+
+    def with_inverse(self, state: Belted) -> Belted:
+        """The state with its Jacobian inverse, for continuing by the chord method."""
+        if state.mode == "free":
+            return state
+        return replace(state, inverse=self.transcription(state.mode).chord.inverse(
+            state.z, self.q(state)))
+
+    def calls(self, mode: str) -> tuple[Buffered, Buffered, Buffered]:
+        """A mode's Newton solve (z0, q) -> z (at most MAX_STEP_ITERATIONS
+        iterations), post values and the finger's shape, called through
+        buffers (design/solvers/buffers.py)."""
+        if mode not in self._calls:
+            tr = self.transcription(mode)
+            self._calls[mode] = (Buffered(tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)),
+                                 Buffered(tr.post), Buffered(tr.shape))
+        return self._calls[mode]
+
+    # --------------------------------------------------------- the model's
+    tolerance: float = 1e-12
+
+    def free(self, target: Belted) -> Belted:
+        """The straight finger with the bird and the belt moved back to first
+        touch (or left where they are if it misses them)."""
+        raise NotImplementedError
+
+    def transcription(self, mode: str):
+        raise NotImplementedError
+
+    def q(self, state: Belted) -> np.ndarray:
+        raise NotImplementedError
+
+    def solved(self, state: Belted, post: np.ndarray) -> Belted | None:
+        """A converged Newton solve's state with its post values in the belt
+        layout (None: the solve left the branch)."""
+        raise NotImplementedError
+
+    def tip(self, state: Belted) -> np.ndarray:
+        """The finger's tip in its frame (m)."""
+        raise NotImplementedError
+
+    def depth(self, state: Belted, kind: str) -> float:
+        """How far (m) the finger is into the belt (``kind`` belt: its tip) or
+        the bird (``bird``; the bird out of reach: -inf), < 0 clear of it."""
+        raise NotImplementedError
+
+    def excess(self, state: Belted, kind: str) -> float:
+        """:meth:`depth` beyond what the state allows before a contact starts."""
+        return self.depth(state, kind) - (state.graze if kind == "bird" else 0.0)
+
+    def event(self, state: Belted) -> tuple[str, float] | None:
+        """The first thing wrong with a solved state and how far past its
+        crossing it is: a contact to end (``release-bird``,
+        ``release-belt``), to start (``bird``, ``belt``), a switch between
+        interior and tip (``to-tip``, ``to-interior``), the contact at the
+        base (``base``)."""
+        mode, post = state.mode, state.post
+        if mode in BIRD_MODES:
+            if self.pulls(post):
+                return "release-bird", 0.0
+            arc = post[self.POST_ARC]
+            interior = mode.startswith("interior")
+            if interior and arc > self.length * (1 + 1e-12):
+                return "to-tip", 0.0
+            if interior and arc <= BASE_FRACTION * self.length:
+                return "base", 0.0
+            if not interior and post[self.POST_ALONG] > 0:
+                return "to-interior", 0.0
+        if mode in BELT_MODES:
+            if post[self.POST_BELT_FORCE] < 0:
+                return "release-belt", 0.0
+        elif self.depth(state, "belt") > 0.0:
+            return "belt", self.depth(state, "belt")
+        if mode not in BIRD_MODES and self.excess(state, "bird") > 0.0:
+            return "bird", self.excess(state, "bird")
+        return None
+
+    #: where the post values hold the bird's contact arc length, the tangency
+    #: d1·n (tip contact) and the belt's normal force
+    POST_ARC: int
+    POST_ALONG: int
+    POST_BELT_FORCE: int
+
+    def pulls(self, post: np.ndarray) -> bool:
+        """Whether the bird's contact force would pull the finger into the bird."""
+        raise NotImplementedError
+
+    def switch(self, state: Belted, kind: str) -> Belted | None:
+        """The state in the mode after the event ``kind``, its unknowns mapped
+        (solved at the new parameters by the caller)."""
+        raise NotImplementedError

@@ -1,0 +1,310 @@
+"""A spatial rod finger against the bird and the belt (the ``spatial`` model).
+
+The continuation and its events are :mod:`design.solvers.contact.belt_continuation`'s;
+here are the rod's equations (bird-only: spatial_equations.py; with the
+belt: spatial_belt_equations.py), its geometry and the maps between the
+modes' unknowns. The finger's points below the belt away from its tip are
+reported as the solution's ``below_belt``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from design.physics.rod import quaternion_rotation
+from design.solvers.beam.collocation import legendre_tables
+from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, EVENT_DEPTH,
+                                                    Belted, BeltedContact, Plane)
+from design.solvers.contact.robust import BASE_FRACTION
+from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
+                                          SpatialSolution, SpatialState, grazing_shift,
+                                          segment_level)
+from design.solvers.contact.spatial_belt_equations import (POST_BELT_FORCE, POST_BELT_ON_FINGER,
+                                                         POST_TIP, belt_transcription,
+                                                         overhang_widths)
+
+#: a quadric for the belt-only modes, which ignore the bird
+_NO_BIRD = Quadric(np.array([0.0, 0.0, 1.0]), np.eye(3))
+
+
+class SpatialBeltContact(BeltedContact):
+    """The contact of one spatial rod finger with the bird and the belt.
+
+    Parameters
+    ----------
+    contact : SpatialContact
+        The finger's bird-only solver: its finger, mesh, tolerance and
+        bird-only transcriptions are shared.
+    """
+
+    n_bird = 9
+
+    def __init__(self, contact: SpatialContact):
+        super().__init__()
+        self.contact = contact
+        self.length = contact.finger.length
+        self.tolerance, self.max_steps = contact.tolerance, contact.max_steps
+        self.widths2 = overhang_widths()
+        self.belt_tail = np.concatenate([contact.widths, self.widths2, contact.stiffness.params])
+        rod = contact.tr["interior"].rod
+        self.n_rod = rod.n_w
+        self.tr = {m: belt_transcription(contact.stiffness, rod.K, rod.d, m) for m in BELT_MODES}
+        self.n_over = self.tr["interior+belt"].overhang.n_w
+        self.tau = legendre_tables(rod.d)[0]
+
+    # ----------------------------------------------------------------- API
+    def solve(self, quadric: Quadric | None, friction, plane: Plane, belt,
+              previous: Belted | None = None, detail: bool = True
+              ) -> tuple[SpatialSolution, Belted | None]:
+        """The finger against ``quadric`` (the bird in the finger frame; None
+        when it cannot be reached) under the friction law ``friction``, and
+        the belt ``plane`` under the law ``belt``, continued from
+        ``previous``. Returns the solution and the state to continue from."""
+        if quadric is not None and quadric.level(np.zeros((3, 1)))[0] <= 0.0:
+            return self._failed("the finger base is inside the object: invalid pose"), None
+        target = Belted("free", None, None if quadric is None else quadric.params,
+                        FrictionLaw.of(friction).params, plane, FrictionLaw.of(belt).params)
+        state, msg = self.continued(target, previous)
+        if state is None:
+            return self._failed(msg), None
+        return self._solution(state, msg, detail), self.with_inverse(state) if detail else state
+
+    def adopt(self, state: SpatialState, plane: Plane, belt) -> Belted:
+        """A bird-only state of :class:`SpatialContact` to continue here, with
+        the belt ``plane`` lowered to its tip: the belt then comes in from
+        first touch."""
+        return self.lowered(Belted(state.mode, state.z, state.quadric.params, state.friction,
+                                   plane, FrictionLaw.of(belt).params))
+
+    def bird_only(self, state: Belted) -> SpatialState | None:
+        """A state off the belt as :class:`SpatialContact`'s (None when free)."""
+        if state.mode not in ("interior", "tip"):
+            return None
+        return SpatialState(state.mode, state.z, Quadric.from_params(state.bird), state.friction,
+                            state.post[:19])
+
+    # --------------------------------------------------------- the model's
+    def free(self, target: Belted) -> Belted:
+        bird = target.bird
+        if bird is not None:
+            quadric = Quadric.from_params(bird)
+            if segment_level(quadric, self.length) < 0.0:
+                graze = grazing_shift(quadric, self.length)
+                bird = quadric.shifted(graze[0]).params if graze is not None else None
+        tip = np.array([self.length, 0.0, 0.0])
+        return Belted("free", None, bird, NO_FRICTION, target.plane.lowered_to(tip), NO_FRICTION)
+
+    def transcription(self, mode: str):
+        return self.tr[mode] if mode in BELT_MODES else self.contact.tr[mode]
+
+    def q(self, state: Belted) -> np.ndarray:
+        c = self.contact
+        bird = _NO_BIRD.params if state.bird is None else state.bird
+        if state.mode in BELT_MODES:
+            return np.concatenate([[self.length, c.ei_ref], bird, state.friction,
+                                   state.plane.params, state.belt, self.belt_tail])
+        return np.concatenate([[self.length, c.ei_ref], bird, state.friction, c.tail])
+
+    def solved(self, state: Belted, post: np.ndarray) -> Belted:
+        if state.mode in BELT_MODES:
+            return replace(state, post=post)
+        # a bird-only mode: the tip (straight beyond the contact) and its height
+        tip = post[:3] + post[13:16] * (self.length - post[4])
+        level = float(state.plane.level(tip[:, None])[0])
+        return replace(state, post=np.concatenate([
+            post[:19], tip, [0.0, level, float(post[13:16] @ state.plane.normal)], np.zeros(6)]))
+
+    POST_ARC, POST_ALONG, POST_BELT_FORCE = 4, 6, POST_BELT_FORCE
+
+    def pulls(self, post: np.ndarray) -> bool:
+        return bool(post[3] < 0)
+
+    def depth(self, state: Belted, kind: str) -> float:
+        if kind == "belt":
+            return -float(state.plane.level(self.tip(state)[:, None])[0])
+        return -np.inf if state.bird is None else self._bird_depth(state)
+
+    def switch(self, state: Belted, kind: str) -> Belted | None:
+        mode, z, n1, n2 = state.mode, state.z, self.n_rod, self.n_over
+        if kind == "belt":
+            if mode == "free":
+                return replace(state, mode="belt", z=np.append(self._straight(), 0.0))
+            extra = [0.0] if mode == "tip" else None
+            z_new = np.append(z, extra) if extra else \
+                np.concatenate([z[:n1], self._straight_overhang(), z[n1:n1 + 2], [0.0]])
+            return replace(state, mode=f"{mode}+belt", z=z_new)
+        if kind == "bird":
+            arc = self._grazing(state)
+            if arc is None:
+                return None
+            at_tip = arc >= self.length * (1 - 1e-12)
+            if mode == "free":
+                extra = [0.0] if at_tip else [0.0, arc / self.length]
+                return replace(state, mode="tip" if at_tip else "interior",
+                               z=np.append(self._straight(), extra))
+            w, nu_p = z[:n1], z[-1]
+            if at_tip:
+                return replace(state, mode="tip+belt", z=np.concatenate([w, [0.0, nu_p]]))
+            u = arc / self.length
+            return replace(state, mode="interior+belt",
+                           z=np.concatenate([*self._split(w, u), [0.0, u, nu_p]]))
+        if kind == "release-belt":
+            if mode == "belt":
+                return replace(state, mode="free", z=None, post=None)
+            if mode == "tip+belt":
+                return replace(state, mode="tip", z=z[:n1 + 1])
+            return replace(state, mode="interior", z=np.concatenate([z[:n1], z[n1 + n2:-1]]))
+        if kind == "release-bird":
+            if mode in ("interior", "tip"):
+                return replace(state, mode="free", z=None, post=None)
+            if mode == "tip+belt":
+                return replace(state, mode="belt", z=np.append(z[:n1], z[-1]))
+            joined = self._join(z[:n1], z[n1:n1 + n2], z[n1 + n2 + 1])
+            return replace(state, mode="belt", z=np.append(joined, z[-1]))
+        if kind == "to-tip":
+            if mode == "interior":
+                return replace(state, mode="tip", z=z[:n1 + 1])
+            return replace(state, mode="tip+belt", z=np.concatenate([z[:n1], [z[n1 + n2], z[-1]]]))
+        if mode == "tip":                                           # to-interior
+            return replace(state, mode="interior", z=np.append(z, 1.0))
+        return replace(state, mode="interior+belt",
+                       z=np.concatenate([z[:n1], self._straight_overhang(), [z[n1], 1.0, z[-1]]]))
+
+    # ---------------------------------------------------------- geometry
+    def tip(self, state: Belted) -> np.ndarray:
+        return np.array([self.length, 0.0, 0.0]) if state.mode == "free" else state.post[POST_TIP]
+
+    def _points(self, state: Belted) -> np.ndarray:
+        """The finger's points (3, n), base to tip."""
+        if state.mode == "free":
+            return np.vstack([np.linspace(0.0, self.length, 16), np.zeros((2, 16))])
+        shape = self.calls(state.mode)[2](state.z, self.q(state))
+        if state.mode in BELT_MODES:
+            return shape[0]
+        r = shape[1]
+        post = state.post
+        rest = np.linspace(0.0, self.length - post[4], 6)[1:]
+        return np.hstack([r, post[:3, None] + post[13:16, None] * rest[None, :]])
+
+    def _bird_depth(self, state: Belted) -> float:
+        """How deep the finger (not touching the bird) is inside it (m; ≤ 0 outside)."""
+        quadric = Quadric.from_params(state.bird)
+        if state.mode == "free":
+            level = segment_level(quadric, self.length)
+        else:
+            level = float(np.min(quadric.level(self._points(state))))
+        return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
+
+    def _grazing(self, state: Belted) -> float | None:
+        """Arc length (m) where the finger enters the bird most deeply."""
+        quadric = Quadric.from_params(state.bird)
+        if state.mode == "free":
+            graze = grazing_shift(quadric, self.length)
+            return None if graze is None else graze[1]
+        pts = self._points(state)
+        arcs = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=1), axis=0))])
+        arcs *= self.length / arcs[-1]
+        k = int(np.argmin(quadric.level(pts)))
+        return float(arcs[k]) if arcs[k] > BASE_FRACTION * self.length else None
+
+    def _straight(self) -> np.ndarray:
+        return self.contact.tr["interior"].rod.straight()
+
+    def _straight_overhang(self) -> np.ndarray:
+        return self.tr["interior+belt"].overhang.straight()
+
+    def _split(self, w: np.ndarray, u: float) -> tuple[np.ndarray, np.ndarray]:
+        """A whole-finger rod state (over [0, l], μ = m l / EI_r) as the two
+        segments of interior+belt split at u = L / l (interpolated): the
+        second in the first's end frame."""
+        widths = self.contact.widths
+        first = _evaluate(w, widths, self.tau, u * _nodes(widths, self.tau))
+        first[4:] *= u
+        at = _unit(_evaluate(w, widths, self.tau, np.array([u]))[:4, 0])
+        second = _evaluate(w, widths, self.tau, u + (1.0 - u) * _nodes(self.widths2, self.tau))
+        back = _conjugate(at)
+        second[:4] = np.column_stack([_multiply(back, q) for q in second[:4].T])
+        second[4:] = quaternion_rotation(at).T @ second[4:] * (1.0 - u)
+        return first.T.ravel(), second.T.ravel()
+
+    def _join(self, w1: np.ndarray, w2: np.ndarray, u: float) -> np.ndarray:
+        """The inverse of :meth:`_split`: the two segments as one rod state."""
+        widths = self.contact.widths
+        nodes = _nodes(widths, self.tau)
+        end = _unit(_evaluate(w1, widths, self.tau, np.array([1.0]))[:4, 0])
+        out = np.zeros((7, nodes.size))
+        inner = nodes < u
+        out[:, inner] = _evaluate(w1, widths, self.tau, nodes[inner] / u)
+        out[4:, inner] /= u
+        outer = _evaluate(w2, self.widths2, self.tau, (nodes[~inner] - u) / (1.0 - u))
+        out[:4, ~inner] = np.column_stack([_multiply(end, q) for q in outer[:4].T])
+        out[4:, ~inner] = quaternion_rotation(end) @ outer[4:] / (1.0 - u)
+        return out.T.ravel()
+
+    # -------------------------------------------------------------- output
+    def _failed(self, message: str) -> SpatialSolution:
+        return SpatialSolution(False, np.zeros(3), 0.0, None, None, 0.0, False, False, message,
+                               shape_points=np.vstack([np.linspace(0.0, self.length, 2),
+                                                       np.zeros((2, 2))]))
+
+    def _solution(self, state: Belted, msg: str, detail: bool) -> SpatialSolution:
+        """The state as a :class:`SpatialSolution` with the belt's part."""
+        if state.held < 1.0:
+            msg = "; ".join(m for m in (msg, f"sticking: the finger carries {state.held:.0%} of "
+                                             f"the sliding friction (no equilibrium beyond)") if m)
+        mode, post = state.mode, state.post
+        pts = self._points(state) if detail else None
+        belt = {"below_belt": 0.0 if pts is None else
+                float(max(0.0, -state.plane.level(pts).min()))}
+        if mode in BELT_MODES:
+            belt.update(belt_force=-post[POST_BELT_ON_FINGER],
+                        belt_normal_force=float(post[POST_BELT_FORCE]),
+                        belt_point=post[POST_TIP].copy())
+        extras = {"mode": mode, "z": None if state.z is None else state.z.copy(),
+                  "iterations": self.newton_iterations, "friction_held": state.held}
+        if mode not in BIRD_MODES:
+            return SpatialSolution(False, np.zeros(3), 0.0, None, None, 0.0, False, True, msg,
+                                   shape_points=pts, extras=extras, **belt)
+        extras["friction"] = post[16:19].copy()
+        return SpatialSolution(True, -post[10:13], float(post[3]), post[:3].copy(),
+                               post[7:10].copy(), float(post[4]), mode.startswith("tip"), True,
+                               msg, 0.0, pts, extras=extras, **belt)
+
+
+# ------------------------------------------------------ rod state helpers
+def _nodes(widths: np.ndarray, tau: np.ndarray) -> np.ndarray:
+    """u of each stored node: every interval's start and collocation points."""
+    starts = np.concatenate([[0.0], np.cumsum(widths)[:-1]])
+    return (starts[:, None] + tau[None, :] * widths[:, None]).ravel()
+
+
+def _evaluate(w: np.ndarray, widths: np.ndarray, tau: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """The collocated state (states per node, n) at u in [0, 1], by each
+    interval's Lagrange polynomial through its d + 1 nodes."""
+    d1 = tau.size
+    states = w.reshape(widths.size * d1, -1).T
+    edges = np.concatenate([[0.0], np.cumsum(widths)])
+    out = np.zeros((states.shape[0], u.size))
+    for i, x in enumerate(u):
+        j = int(np.clip(np.searchsorted(edges, x, side="right") - 1, 0, widths.size - 1))
+        s = (x - edges[j]) / widths[j]
+        basis = np.array([np.prod([(s - tau[r]) / (tau[k] - tau[r]) for r in range(d1) if r != k])
+                          for k in range(d1)])
+        out[:, i] = states[:, j * d1:(j + 1) * d1] @ basis
+    return out
+
+
+def _unit(q: np.ndarray) -> np.ndarray:
+    return q / np.linalg.norm(q)
+
+
+def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Quaternion product a ⊗ b, (w, x, y, z)."""
+    w1, v1, w2, v2 = a[0], a[1:], b[0], b[1:]
+    return np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+
+
+def _conjugate(q: np.ndarray) -> np.ndarray:
+    return np.concatenate([[q[0]], -q[1:]])

@@ -1,0 +1,705 @@
+"""Finger forces on the bird in 3-D, both drums (thesis §4.3; MODEL.md §4).
+
+For every finger of the right drum at time t and bird pose (X, Z, θ): the
+finger's frame on the drum and its contact with the bird, continued from the
+finger's previous state, mapped back to the world. Two contact models:
+
+* ``planar`` (the thesis's): the finger's bending plane cuts the bird in an
+  ellipse, the 2-D contact is solved in it and only its in-plane force acts;
+* ``spatial``: the finger is a rod bending about both section axes and
+  twisting (design/physics/rod.py) against the whole ellipsoid; the force
+  acts along the surface normal with 3-D Coulomb friction.
+
+Every contact reports how far it leaves the finger's bending plane (the
+out-of-plane shares of the surface normal and of the sweep), which is what
+decides whether the planar model may be used. A contact that cannot be
+solved raises :class:`ContactFailed`: the run stops there instead of
+counting the finger's force as zero.
+
+The left drum's finger is the mirror image: same force magnitudes, Y
+components opposite, so the symmetric grasp sees twice the right drum's X
+and Z forces and moment.
+
+Model only what can touch: :func:`reach_windows` finds, from the undeformed
+finger loci (eq. 5.1), the time windows in which a finger can reach the bird
+at all; outside them no contact problem is built or solved, and inside them
+none either while the straight finger misses the bird (:func:`straight_level`).
+
+The belt. A finger whose straight tip would pass below the belt's surface
+(design/physics/belt.py) rests on it: the belt pushes its tip up and drags
+it with friction at the finger-belt µ against the tip's sliding over the
+moving belt, and the bird meets the finger so bent. Such a finger is solved
+with the belt while it is inside its reach windows: at accepted instants
+always (its force on the belt is reported), in trial evaluations only while
+the bird comes within the tip's depth below the belt of the straight finger
+(the finger bends up by at most that much). A finger pushed into the belt
+by the bird is solved with the belt from then on.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from design.physics.belt import Belt
+from design.physics.bird import Bird, Loads
+from design.physics.contact import ContactSolution
+from design.physics.ellipse import Ellipse
+from design.physics.grasper import Grasper
+from design.physics.kinematics import Ellipsoid
+from design.solvers.contact import RobustContact
+from design.solvers.contact.spatial import (FrictionLaw, Quadric, SpatialContact,
+                                          SpatialSolution, SpatialState, segment_level)
+from design.solvers.contact.belt_continuation import BELT_MODES, BIRD_MODES, Belted, Plane
+from design.solvers.contact.planar_belt import PlanarBeltContact
+from design.solvers.contact.spatial_belt import SpatialBeltContact
+
+#: finite-difference step (s) for the rates the friction direction needs
+RATE_STEP = 1e-6
+#: a finger's friction reverses only when it slides the other way faster than
+#: this (m/s): flipping it at every sign change of the sliding speed, decided
+#: at accepted steps, chatters (the force jumps by tens of newtons every few
+#: milliseconds)
+REVERSAL_SPEED = 0.02
+#: the spatial finger's Coulomb friction is regularised below this sliding
+#: speed (m/s): F_t = -µ N v / sqrt(|v|² + ε²); the drum sweeps the fingers
+#: past the bird at 0.1-0.5 m/s, so friction is within 1% of µ N above 0.14 m/s
+FRICTION_SPEED = 0.02
+#: the straight finger's least level function (dimensionless) above which it
+#: certainly misses the bird and no contact is solved; nearer the surface each
+#: finger model decides by its own test (the planar one from its section,
+#: whose level differs from the ellipsoid's by rounding)
+MISSES = 1e-9
+#: the friction-reversal margin (m/s) reported where no finger's friction can reverse
+NO_REVERSAL = 1.0
+#: a planar finger meets the belt only where its bending plane is at least this
+#: far (rad) from the belt's plane: rigid out of its plane, it cannot bend onto
+#: a belt nearly parallel to it
+PLANAR_BELT_ANGLE = np.radians(3.0)
+
+
+@dataclass
+class FingerState:
+    """One finger's contact at one instant (right drum), world frame.
+
+    ``normal_out_of_plane`` and ``sweep_out_of_plane`` (0-1): the shares of
+    the bird's surface normal and of the finger's sliding over the surface
+    along the finger's stiff axis (see :meth:`FingerForces._shares`); nan in
+    an integrator's trial evaluations, which only need the loads.
+    """
+
+    force: np.ndarray = field(default_factory=lambda: np.zeros(3))   # on the bird, N
+    point: np.ndarray | None = None                                  # world, m
+    body_point: np.ndarray | None = None                             # bird frame, m
+    solution: ContactSolution | SpatialSolution | None = None
+    normal_out_of_plane: float = 0.0
+    sweep_out_of_plane: float = 0.0
+    #: the contact solver's state, to continue or test from
+    continued: object = None
+
+    @property
+    def magnitude(self) -> float:
+        return float(np.linalg.norm(self.force))
+
+    @property
+    def belt_force(self) -> float:
+        """The finger's normal force on the belt (N; 0 off the belt)."""
+        return float(getattr(self.solution, "belt_normal_force", 0.0))
+
+
+def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end: float,
+                  margin: float = 0.15, dt: float = 1e-3) -> list[list[tuple[float, float]]]:
+    """Per finger, the time windows (s) in which its straight finger can touch
+    the bird, padded by one sample.
+
+    Conservative: the bird's centre is anywhere within ``margin`` (m) of
+    ``centre_path(t)`` = (X, Z) along X and between the conveyor and ``margin``
+    above the path in Z, and any orientation; a finger can touch only if its
+    undeformed segment comes within the largest semi-axis of that region.
+    Contact needs the straight finger to enter the bird, so outside these
+    windows the force is zero.
+    """
+    drum = grasper.drum(speed)
+    times = np.arange(0.0, t_end + dt, dt)
+    reach = max(bird.eta, bird.lam, bird.gamma)
+    centres = np.array([centre_path(t) for t in times])               # (n, 2): X, Z
+    lo = np.stack([centres[:, 0] - margin, np.zeros(times.size), np.zeros(times.size)], axis=1)
+    hi = np.stack([centres[:, 0] + margin, np.zeros(times.size), centres[:, 1] + margin], axis=1)
+    s = np.linspace(0.0, 1.0, 24)[None, :, None]
+    turns = drum.turning(times)
+    out = []
+    for gf in grasper.fingers:
+        base0, R0 = drum.frame(gf.mount, 0.0)
+        base = drum.origin + turns @ (base0 - drum.origin)
+        axis = turns @ R0[:, 0]
+        pts = base[:, None, :] + s * gf.finger.length * axis[:, None, :]   # (n, 24, 3)
+        gap = np.maximum(np.maximum(lo[:, None, :] - pts, 0.0), pts - hi[:, None, :])
+        near = np.min(np.linalg.norm(gap, axis=2), axis=1) <= reach
+        out.append(_windows(near, times, dt))
+    return out
+
+
+def _windows(near: np.ndarray, times: np.ndarray, dt: float) -> list[tuple[float, float]]:
+    """The runs of True in ``near`` as time windows padded by one sample."""
+    windows = []
+    k = 0
+    while k < near.size:
+        if near[k]:
+            j = k
+            while j + 1 < near.size and near[j + 1]:
+                j += 1
+            windows.append((max(0.0, times[k] - dt), times[j] + dt))
+            k = j + 1
+        else:
+            k += 1
+    return windows
+
+
+class ContactFailed(RuntimeError):
+    """A finger's contact could not be solved: the run cannot go on honestly
+    (counting the finger's force as zero would lower the peak force)."""
+
+    def __init__(self, t: float, finger: str, message: str):
+        super().__init__(f"finger {finger}'s contact failed at t = {t:.4f} s: {message}")
+        self.t, self.finger, self.reason = t, finger, message
+
+
+class PlanarFinger:
+    """The thesis's finger (§4.3): rigid out of its bending plane; the plane
+    cuts the bird in an ellipse, the planar contact is solved in it and only
+    its in-plane force acts (eq. 4.26: no force along z_f). Friction at the
+    edge of sliding, reversed when the finger clearly slides the other way."""
+
+    name = "planar"
+    from_committed = False
+    #: the friction's sense follows the finger's sliding (settled at accepted steps)
+    settles_friction = True
+
+    def __init__(self, finger, friction: float, intervals: int, degree: int,
+                 reversal_speed: float = REVERSAL_SPEED):
+        self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
+                                    reversal_speed=reversal_speed)
+        self.reverses = friction > 0 and self.settles_friction
+        self._belted: PlanarBeltContact | None = None
+
+    @property
+    def belted(self) -> PlanarBeltContact:
+        """The solver with the belt (built on first use: most fingers never need it)."""
+        if self._belted is None:
+            self._belted = PlanarBeltContact(self.solver)
+        return self._belted
+
+    def reversal_margin(self, state, kin_factory) -> float:
+        """:meth:`RobustContact.reversal_margin` of a contact state (m/s)."""
+        state = state.with_ellipse()
+        return self.solver.reversal_margin(state, kin_factory(state.ellipse))
+
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
+        """(force on the bird (3,) world, contact point (3,) world, solution,
+        state to continue from); force None when the plane misses the bird.
+        A trial evaluation continued from a contact is first tried in one
+        Newton solve (:meth:`RobustContact.continue_trial`). ``belt``:
+        (plane, friction law) in the finger frame where the finger may meet
+        the belt, else None; the planar finger meets it in its bending plane
+        (:meth:`_line`)."""
+        line = self._line(belt)
+        length = self.solver.finger.length
+        resting = line is not None and line[0].level(np.array([[length], [0.0]]))[0] < 0.0
+        if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
+            start = self.belted.bird_only(start)         # off the belt: the bird-only solver
+        if line is not None and (isinstance(start, Belted) or resting):
+            return self._belted_solve(body, base, R, kin_factory,
+                                      start if isinstance(start, Belted) else None, commit, line)
+        start = None if isinstance(start, Belted) else start
+        if not commit and start is not None:
+            center, B, rhs = body.section(base, R)
+            trial = self.solver.continue_trial(start, center, B) if rhs > 0.0 else None
+            if trial is not None:
+                return self._checked(body, base, R, kin_factory, commit, line, *trial)
+        cut = body.cut(base, R)
+        if cut is None:
+            return None, None, None, None
+        made = []
+
+        def kin(p_f):
+            # built on first use: only a committed solve settles its friction
+            # from the sliding, and building it (two finger frames and the bird
+            # a step on) took a fifth of a trial evaluation's time
+            if not made:
+                made.append(kin_factory(cut))
+            return made[0](p_f)
+
+        sol, cont = self.solver.solve_frame(cut, "auto", kin if self.settles_friction else None,
+                                            start, settle=commit, detail=commit)
+        return self._checked(body, base, R, kin_factory, commit, line, sol, cont)
+
+    def _checked(self, body, base, R, kin_factory, commit, line, sol, cont):
+        """A bird-only solution, or, where it pushes the tip below the belt,
+        the solution with the belt continued from it."""
+        if line is not None and sol.contact and cont is not None:
+            psi, arc = sol.psi, sol.arc_length
+            tip = np.asarray(sol.point) + (self.solver.finger.length - arc) * np.array(
+                [np.cos(psi), np.sin(psi)])
+            if line[0].level(tip[:, None])[0] < 0.0:
+                start = self.belted.adopt(cont, *line)
+                return self._belted_solve(body, base, R, kin_factory, start, commit, line)
+        return self._world(base, R, sol, cont)
+
+    @staticmethod
+    def _line(belt) -> tuple[Plane, np.ndarray] | None:
+        """The belt in the bending plane: its line and friction law ([µ, ε,
+        a (2), G (4)]: the finger's in-plane sliding over the belt, a + G p);
+        None without a belt, or where the bending plane lies within
+        PLANAR_BELT_ANGLE of the belt's (the planar finger, rigid out of its
+        plane, cannot bend onto it)."""
+        if belt is None:
+            return None
+        plane, law = belt
+        size = float(np.linalg.norm(plane.normal[:2]))
+        if size < np.sin(PLANAR_BELT_ANGLE):
+            return None
+        law = FrictionLaw.of(law)
+        return Plane(plane.normal[:2] / size, plane.offset / size), np.concatenate(
+            [[law.mu, law.speed], law.sliding_at_origin[:2], law.sliding_gradient[:2, :2].ravel()])
+
+    def _belted_solve(self, body, base, R, kin_factory, start, commit, line):
+        """The finger with the belt; the bird's section by the bending plane,
+        where the plane cuts the bird (its continuation finds where the bent
+        finger first meets it)."""
+        center, B, rhs = body.section(base, R)
+        conic = (center, B) if rhs > 0.0 else None
+        tau_mu = self._bird_friction(start, conic, kin_factory, body, base, R)
+        sol, cont = self.belted.solve(conic, tau_mu, *line, previous=start, detail=commit)
+        return self._world(base, R, sol, cont)
+
+    def _bird_friction(self, start, conic, kin_factory, body, base, R) -> float:
+        """The bird's signed friction τµ for a finger on the belt: the
+        contact's own while it lasts, else from the rigid finger's sliding
+        over the bird where the straight finger comes nearest to it."""
+        mu = self.solver.mu
+        if mu == 0.0 or conic is None:
+            return 0.0
+        if not self.settles_friction:
+            return mu
+        if start is not None and start.mode in BIRD_MODES:
+            return float(start.friction[0])
+        center, B = conic
+        x = float(np.clip(center[0] + B[0, 1] * center[1] / B[0, 0], 0.0,
+                          self.solver.finger.length))
+        v_object = kin_factory(body.cut(base, R))(np.array([x, 0.0]))[1]
+        return mu if v_object[0] >= 0.0 else -mu
+
+    @staticmethod
+    def _world(base, R, sol, cont):
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        f_w = R[:, :2] @ sol.force_on_object_finger_frame
+        p_w = base + R[:, :2] @ np.asarray(sol.point)
+        return f_w, p_w, sol, cont
+
+
+class SpatialFinger:
+    """The finger as a spatial rod (design/physics/rod.py): it bends about both
+    section axes and twists, so the contact force acts along the bird's
+    surface normal, with Coulomb friction opposite to the finger's sliding
+    over the surface, regularised below FRICTION_SPEED.
+
+    The sliding velocity is the rigid finger's (carried by the drum) relative
+    to the bird's surface, at the contact point solved together with the
+    force (:class:`FrictionLaw`); the finger's own deflection rate is left
+    out. So the friction is a smooth function of the bird's state and time
+    alone. (Taking the contact point from the previous solution instead makes
+    the loads jump at every accepted step: the drum turns the finger's
+    velocity by its angular speed times the point's shift, ε amplifies that,
+    and the adaptive integrator's steps collapse.)
+    :meth:`SpatialContact.sliding_velocity` gives the full material velocity
+    for comparison.
+    """
+
+    name = "spatial"
+    from_committed = True
+    #: friction solved with the contact, regularised: nothing to reverse
+    reverses = False
+
+    def __init__(self, finger, friction: float, intervals: int, degree: int):
+        self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
+        self.mu = float(friction)
+        self._belted: SpatialBeltContact | None = None
+
+    @property
+    def belted(self) -> SpatialBeltContact:
+        """The solver with the belt (built on first use: most fingers never need it)."""
+        if self._belted is None:
+            self._belted = SpatialBeltContact(self.solver)
+        return self._belted
+
+    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
+        """As :meth:`PlanarFinger.solve`; ``belt``: (plane, friction law) in the
+        finger frame where the finger may meet the belt, else None."""
+        quadric = body_quadric(body, base, R)
+        misses = segment_level(quadric, self.solver.finger.length) >= 0.0
+        resting = belt is not None and belt[0].level(
+            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
+            start = self.belted.bird_only(start)         # off the belt: the bird-only solver
+        if belt is not None and (resting or isinstance(start, Belted)):
+            return self._belted_solve(body, quadric, base, R, kin_factory,
+                                      start if isinstance(start, Belted) else None, commit, belt)
+        if misses:
+            return None, None, None, None
+        start = start if isinstance(start, SpatialState) else None
+        sol, cont = self.solver.solve(quadric, self._law(kin_factory, quadric), start,
+                                      detail=commit)
+        if belt is not None and sol.contact and cont is not None and \
+                belt[0].level(self._tip(sol, cont)[:, None])[0] < 0.0:
+            # pushed into the belt by the bird: solved with it from the bird-only state
+            return self._belted_solve(body, quadric, base, R, kin_factory,
+                                      self.belted.adopt(cont, *belt), commit, belt)
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        return R @ sol.force, base + R @ sol.point, sol, cont
+
+    def _law(self, kin_factory, quadric) -> FrictionLaw:
+        """The bird's friction law in the finger frame: regularised Coulomb
+        against the rigid finger's sliding over the bird's surface."""
+        if self.mu <= 0:
+            return FrictionLaw()
+        # the object's velocity field is affine in the point: sample it at 0 and e_i
+        kin = kin_factory(quadric)
+        v0 = kin(np.zeros(3))[1]
+        gradient = np.column_stack([kin(e)[1] - v0 for e in np.eye(3)])
+        return FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-v0,
+                           sliding_gradient=-gradient)
+
+    def _tip(self, sol: SpatialSolution, state: SpatialState) -> np.ndarray:
+        """The finger's tip (finger frame) in a bird-only contact."""
+        post = state.post
+        return post[:3] + post[13:16] * (self.solver.finger.length - post[4])
+
+    def _belted_solve(self, body, quadric, base, R, kin_factory, start, commit, belt):
+        """The finger with the belt and the bird (its continuation finds where
+        the bent finger first meets the bird)."""
+        sol, cont = self.belted.solve(quadric, self._law(kin_factory, quadric), belt[0], belt[1],
+                                      start, detail=commit)
+        if not sol.contact:
+            return np.zeros(3), None, sol, cont
+        return R @ sol.force, base + R @ sol.point, sol, cont
+
+
+class ThesisPlanarFinger(PlanarFinger):
+    """The planar finger with the thesis's chapter III friction convention:
+    friction on the finger at µ, pointing tipwards, whatever the sliding (what
+    its Algorithms I and II and Tables 3-2 to 3-5 use). For reproducing the
+    thesis's own simulations: its FEM (Table 3-6) follows friction from the
+    sliding, as ``planar`` does (the pass's peak: FEM 31.8 N, ``planar``'s
+    friction 31.0 N, this convention 24.5 N)."""
+
+    name = "planar-thesis"
+    settles_friction = False
+
+
+#: contact models by name
+FINGER_MODELS = {m.name: m for m in (PlanarFinger, ThesisPlanarFinger, SpatialFinger)}
+
+
+def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
+    """min over the straight finger (base + x axis, 0 ≤ x ≤ length) of the
+    bird's level function |D q|² - 1, q in body coordinates, D = diag(1/η,
+    1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
+    For n fingers at once: base and axis (n, 3), length (n,); returns (n,)."""
+    scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
+    p = scale * ((base - np.asarray(body.center)) @ body.rotation)
+    e = scale * (axis @ body.rotation)
+    x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
+    q = p + x[..., None] * e
+    return np.sum(q * q, axis=-1) - 1.0
+
+
+def body_quadric(body: Ellipsoid, base: np.ndarray, R: np.ndarray) -> Quadric:
+    """The bird's ellipsoid in a finger frame (base, R) as a quadric."""
+    Rb = R.T @ body.rotation
+    return Quadric(R.T @ (np.asarray(body.center, float) - base), Rb @ body.matrix @ Rb.T)
+
+
+class FingerForces:
+    """All fingers' forces on the bird, continued in time finger by finger.
+
+    ``evaluate(t, y, commit)`` returns the summed loads and each finger's
+    state. Trial evaluations (``commit`` false) keep each contact's friction
+    from the last committed state; committed ones (accepted integrator
+    steps) also decide it from the sliding velocity and become the states
+    later evaluations continue from. A contact that cannot be solved raises
+    :class:`ContactFailed`.
+    """
+
+    def __init__(self, grasper: Grasper, bird: Bird, drum_speed: float, friction: float,
+                 windows: list[list[tuple[float, float]]] | None = None,
+                 intervals: int = 8, degree: int = 4, model: str = "planar",
+                 belt: Belt = Belt(), belt_friction: float = 0.0):
+        self.grasper, self.bird = grasper, bird
+        self.belt, self.belt_friction = belt, float(belt_friction)
+        #: the belt's speed (m/s) at time t; the grasp that drives the belt sets it
+        self.belt_speed = lambda t: 0.0
+        self.drum = grasper.drum(drum_speed)
+        kind = FINGER_MODELS[model]
+        self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
+        self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
+        self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
+        self.solves = 0            # contact problems solved
+        self.skipped = 0           # finger evaluations the reach windows saved
+        self._memo: dict = {}      # trial evaluations since the last commit
+        self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
+        self._frames: dict = {}    # t -> every finger's frame, for the latest times
+        start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
+        self._base0 = np.array([base for base, _ in start])
+        self._R0 = np.array([R for _, R in start])
+        self._lengths = np.array([gf.finger.length for gf in grasper.fingers])
+        # every window's start, end and finger, for a vectorised test
+        spans = [(a, b, i) for i, w in enumerate(windows or []) for a, b in w]
+        self._window_ends = None if windows is None else (
+            np.array([a for a, _, _ in spans], float), np.array([b for _, b, _ in spans], float),
+            np.array([i for _, _, i in spans], int))
+
+    def frames(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Every finger's base (n, 3) and rotation (n, 3, 3) at time t: their
+        frames at t = 0 turned with the drum. An evaluation asks for the same
+        time several times (reach, contact, rates at t + RATE_STEP, shares);
+        the arrays are shared, hence read-only."""
+        out = self._frames.get(t)
+        if out is None:
+            if len(self._frames) > 64:
+                self._frames.clear()
+            turn = self.drum.turning(t)
+            origin = self.drum.origin
+            out = (origin + (self._base0 - origin) @ turn.T, turn @ self._R0)
+            for a in out:
+                a.setflags(write=False)
+            self._frames[t] = out
+        return out
+
+    def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Finger i's (base, R) at time t (:meth:`frames`)."""
+        bases, rotations = self.frames(t)
+        return bases[i], rotations[i]
+
+    def reaching(self, t: float, body: Ellipsoid) -> set[int]:
+        """The fingers to solve at time t, among those inside their reach
+        windows (the others count as skipped): those whose straight line
+        enters the bird (level ≤ MISSES), and those resting on the belt (the
+        straight tip below it), which the bird may meet bent: every
+        evaluation solves the same ones, so that a trial sees what the
+        accepted instant will."""
+        if self._window_ends is None:
+            inside = np.arange(len(self.models))
+        else:
+            lo, hi, owner = self._window_ends
+            inside = np.unique(owner[(lo <= t) & (t <= hi)])
+        self.skipped += len(self.models) - inside.size
+        if inside.size == 0:
+            return set()
+        bases, rotations = self.frames(t)
+        axes, lengths = rotations[inside, :, 0], self._lengths[inside]
+        out = set(inside[straight_level(body, bases[inside], axes, lengths) <= MISSES].tolist())
+        tips = bases[inside] + axes * lengths[:, None]
+        depth = -tips[:, 2]
+        resting = (depth > 0) & np.array([self.belt.touches(self.grasper.fingers[i].design_name,
+                                                           tip[1]) for i, tip in zip(inside, tips)])
+        return out | set(inside[resting].tolist())
+
+    def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
+        """The belt as finger i sees it at time t: the plane Z = 0 and the
+        friction law against the finger's sliding over the moving belt, in
+        the finger frame; None where the finger passes beside it or through
+        a slot (judged at its straight tip)."""
+        base, R = self.frame(i, t)
+        tip = base + R[:, 0] * self._lengths[i]
+        if not self.belt.touches(self.grasper.fingers[i].design_name, tip[1]):
+            return None
+        plane = Plane(R[2].copy(), -float(base[2]))
+        if self.belt_friction <= 0.0:
+            return plane, FrictionLaw()
+        dt = RATE_STEP
+        base2, R2 = self.frame(i, t + dt)
+        belt = np.array([self.belt_speed(t) * dt, 0.0, 0.0])
+        # the belt's material velocity relative to the finger frame at r: v0 + G r
+        v0 = R2.T @ (base + belt - base2) / dt
+        G = (R2.T @ R - np.eye(3)) / dt
+        return plane, FrictionLaw(mu=self.belt_friction, speed=FRICTION_SPEED,
+                                  sliding_at_origin=-v0, sliding_gradient=-G)
+
+    def ellipsoid(self, y: np.ndarray) -> Ellipsoid:
+        b = self.bird
+        return Ellipsoid(b.eta, b.lam, b.gamma, (y[0], 0.0, y[1]), y[2])
+
+    def evaluate(self, t: float, y: np.ndarray, commit: bool = False
+                 ) -> tuple[Loads, list[FingerState]]:
+        key = (t, y.tobytes())
+        if not commit and key in self._memo:
+            return self._memo[key]
+        out = self._evaluate(t, y, commit)
+        if commit:
+            self._memo.clear()
+            self._margins.clear()
+        elif len(self._memo) > 16:
+            self._memo.pop(next(iter(self._memo)))
+        self._memo[key] = out
+        return out
+
+    def _evaluate(self, t: float, y: np.ndarray, commit: bool) -> tuple[Loads, list[FingerState]]:
+        body = self.ellipsoid(y)
+        loads, states = Loads(), []
+        centre = np.array([y[0], 0.0, y[1]])
+        reaching = self.reaching(t, body)
+        for i, gf in enumerate(self.grasper.fingers):
+            force = None
+            if i in reaching:
+                base, R = self.frame(i, t)
+                # continue from the latest solution, trial or committed: the nearest
+                # in time (trials keep the committed friction); or, for a model whose
+                # friction is solved with the contact (spatial), always from the
+                # committed one, so that trials cannot wander onto another branch
+                model = self.models[i]
+                start = self.states[i] if commit or model.from_committed else self.trials[i]
+                force, p_w, sol, cont = model.solve(
+                    body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
+                    commit, self.belt_contact(i, t))
+            if force is None:                       # out of reach: no contact problem
+                self.trials[i] = None
+                if commit:
+                    self.states[i] = None
+                states.append(FingerState())
+                continue
+            self.solves += 1
+            if not sol.converged:
+                raise ContactFailed(t, gf.name, sol.message)
+            self.trials[i] = cont
+            if commit:
+                self.states[i] = cont
+            if p_w is None:
+                states.append(FingerState(solution=sol))
+                continue
+            r = p_w - centre
+            loads.qx += 2 * force[0]
+            loads.qz += 2 * force[2]
+            loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
+            shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
+            states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
+        return loads, states
+
+    def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
+        """The fingers' states at (t, y), a trial evaluation continued from an
+        earlier :meth:`snapshot`, leaving this object exactly as it was (a
+        look inside an accepted step that changes nothing after it)."""
+        kept = self.states, self.trials, self._memo, self._margins
+        self.states, self.trials = list(snapshot[0]), list(snapshot[1])
+        self._memo, self._margins = {}, {}
+        try:
+            return self._evaluate(t, y, commit=False)[1]
+        finally:
+            self.states, self.trials, self._memo, self._margins = kept
+
+    def snapshot(self) -> tuple[list, list]:
+        """The contacts to continue from (accepted and latest), to go back to."""
+        return list(self.states), list(self.trials)
+
+    def restore(self, snapshot: tuple[list, list]) -> None:
+        """Go back to a :meth:`snapshot`: an accepted instant is withdrawn."""
+        self.states, self.trials = list(snapshot[0]), list(snapshot[1])
+        self._memo.clear()
+        self._margins.clear()
+
+    def reversal_margin(self, t: float, y: np.ndarray) -> float:
+        """The least friction-reversal margin (m/s, :meth:`PlanarFinger.
+        reversal_margin`) of the fingers touching the bird at (t, y) with the
+        friction of their last accepted contact; NO_REVERSAL where none can
+        reverse. Below zero a finger's friction turns: the integrator, finding
+        a friction turned at an accepted instant, locates where within the
+        step it did and accepts that instant instead. (A finger that touches
+        again after a trial without contact starts from first touch with a
+        guessed friction, which the next accepted instant settles: not a
+        reversal.) A finger on the belt keeps its friction's sense
+        (design/solvers/contact/planar_belt.py)."""
+        key = (t, y.tobytes())
+        if key not in self._margins:
+            if len(self._margins) > 16:
+                self._margins.clear()
+            _, states = self.evaluate(t, y)
+            self._margins[key] = min([NO_REVERSAL] + [
+                self.models[i].reversal_margin(st.continued, lambda shape, i=i: self._kinematics(
+                    i, t, y, shape))
+                for i, st in enumerate(states)
+                if self.models[i].reverses and st.point is not None and st.continued is not None
+                and self.states[i] is not None and not isinstance(st.continued, Belted)
+                and not isinstance(self.states[i], Belted)
+                and st.continued.tau_mu == self.states[i].tau_mu])
+        return self._margins[key]
+
+    def _shares(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, p_w: np.ndarray
+                ) -> tuple[float, float]:
+        """How far a contact leaves the finger's bending plane: the share of the
+        bird's surface normal along the stiff axis z_f, |n·z_f|, and of the
+        finger's sweep over the surface, |v·z_f| / |v| (v the rigid finger's
+        velocity relative to the bird's surface at the contact)."""
+        base, R = self.frame(i, t)
+        p_b = body.rotation.T @ (p_w - np.asarray(body.center))
+        n = body.rotation @ (body.matrix @ p_b)
+        n /= np.linalg.norm(n)
+        dt = RATE_STEP
+        base2, R2 = self.frame(i, t + dt)
+        frame_v = (base2 + R2 @ (R.T @ (p_w - base)) - p_w) / dt
+        y2 = y.copy()
+        y2[:3] += dt * y[3:]
+        body2 = self.ellipsoid(y2)
+        object_v = (np.asarray(body2.center) + body2.rotation @ p_b - p_w) / dt
+        v = frame_v - object_v
+        v -= (v @ n) * n
+        speed = np.linalg.norm(v)
+        return float(abs(n @ R[:, 2])), float(abs(v @ R[:, 2]) / speed) if speed > 0 else 0.0
+
+    def _kinematics(self, i: int, t: float, y: np.ndarray, shape):
+        """Rates of the bird's section (planar: the cut ellipse) or quadric
+        (spatial) in finger i's frame, and the bird's surface velocity
+        relative to that frame, by a forward difference over RATE_STEP."""
+        dt = RATE_STEP
+        y2 = y.copy()
+        y2[:3] += dt * y[3:]
+        base, R = self.frame(i, t)
+        base2, R2 = self.frame(i, t + dt)
+        body, body2 = self.ellipsoid(y), self.ellipsoid(y2)
+        planar = isinstance(shape, Ellipse)
+
+        def surface_velocity(p_f: np.ndarray) -> np.ndarray:
+            p3 = np.concatenate([p_f, [0.0]]) if planar else p_f
+            p_w = base + R @ p3
+            p_b = body.rotation.T @ (p_w - np.array(body.center))
+            p_w2 = np.array(body2.center) + body2.rotation @ p_b
+            return (R2.T @ (p_w2 - base2) - p3) / dt
+
+        if not planar:
+            rates = (body_quadric(body2, base2, R2).params - shape.params) / dt
+            return lambda p_f: (rates, surface_velocity(p_f))
+        cut = shape
+
+        def kin(p_f: np.ndarray):
+            cut2 = body2.cut(base2, R2)
+            if cut2 is None:
+                q_dot = np.zeros(5)
+            else:
+                a2, b2, th2 = cut2.a, cut2.b, cut2.theta
+                # the same ellipse may come back with its axes swapped or θ + π
+                if abs(a2 - cut.a) + abs(b2 - cut.b) > abs(b2 - cut.a) + abs(a2 - cut.b):
+                    a2, b2, th2 = b2, a2, th2 + np.pi / 2
+                d_th = (th2 - cut.theta + np.pi / 2) % np.pi - np.pi / 2
+                q_dot = np.array([cut2.center[0] - cut.center[0], cut2.center[1] - cut.center[1],
+                                  d_th, a2 - cut.a, b2 - cut.b]) / dt
+            return q_dot, surface_velocity(p_f)[:2]
+
+        return kin
+
+    @staticmethod
+    def left(state: FingerState) -> tuple[np.ndarray, np.ndarray | None]:
+        """The mirror finger's force and point on the left drum."""
+        m = np.array([1.0, -1.0, 1.0])
+        return state.force * m, None if state.point is None else state.point * m
+

@@ -1,0 +1,195 @@
+"""Newton's method, for every nonlinear solve of the toolkit, with a status.
+
+:func:`damped_newton` solves numpy systems (the beam's finite differences
+and shooting, the thesis's Algorithm II, the BDF-4 step); :class:`NewtonCache`
+builds CasADi rootfinders once per setting (the contact equations).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import casadi as ca
+import numpy as np
+
+
+@dataclass(frozen=True)
+class NewtonResult:
+    """The last iterate ``x`` with its residual, and whether it converged
+    (``message`` says why not)."""
+
+    x: np.ndarray
+    residual: np.ndarray
+    converged: bool
+    iterations: int
+    message: str = ""
+
+
+def damped_newton(fun: Callable[[np.ndarray], tuple[np.ndarray, object]], x0: np.ndarray,
+                  tolerance: float, max_iter: int, *,
+                  solve: Callable[[object, np.ndarray], np.ndarray] = np.linalg.solve,
+                  min_damping: float = 1e-4, relative: bool = False,
+                  residual_tolerance: float = 0.0) -> NewtonResult:
+    """Solve r(x) = 0 by Newton's method with a backtracking line search.
+
+    Parameters
+    ----------
+    fun : callable
+        ``fun(x) -> (r, J)``: the residual (n,) and its Jacobian in the form
+        ``solve`` takes.
+    x0 : ndarray, shape (n,)
+    tolerance : float
+        Converged once the step taken is at most this in max-norm (times
+        max(1, max|x|) if ``relative``), or the residual at most
+        ``residual_tolerance``.
+    max_iter : int
+    solve : callable, optional
+        ``solve(J, b) -> J⁻¹ b`` (dense by default; e.g. a banded solver);
+        a ``LinAlgError`` or ``ValueError`` counts as a singular Jacobian.
+    min_damping : float, optional
+        Each step x + λ Δx, Δx = -J⁻¹ r, halves λ from 1 until |r| decreases
+        (and is finite), or until λ ≤ ``min_damping``, where it is taken
+        anyway; 1 gives the plain (undamped) Newton iteration.
+
+    Returns
+    -------
+    NewtonResult
+        Not converged when the Jacobian is singular, the residual turns
+        non-finite, or ``max_iter`` iterations do not meet the tolerance.
+    """
+    x = np.array(x0, dtype=float)
+    r, jac = fun(x)
+    for it in range(1, max_iter + 1):
+        try:
+            dx = solve(jac, -r)
+        except (np.linalg.LinAlgError, ValueError):
+            return NewtonResult(x, r, False, it, "singular Jacobian")
+        lam, norm0 = 1.0, np.linalg.norm(r)
+        while True:
+            x_try = x + lam * dx
+            r_try, jac_try = fun(x_try)
+            finite = np.all(np.isfinite(r_try))
+            if (finite and np.linalg.norm(r_try) < norm0) or lam <= min_damping:
+                break
+            lam *= 0.5
+        if not finite or not np.all(np.isfinite(x_try)):
+            return NewtonResult(x_try, r_try, False, it, "Newton diverged (non-finite iterate)")
+        x, r, jac = x_try, r_try, jac_try
+        scale = max(1.0, float(np.max(np.abs(x)))) if relative else 1.0
+        if np.max(np.abs(lam * dx)) <= tolerance * scale or \
+                np.max(np.abs(r)) <= residual_tolerance:
+            return NewtonResult(x, r, True, it)
+    return NewtonResult(x, r, False, max_iter,
+                        f"Newton did not converge in {max_iter} iterations")
+
+
+def forward_difference(residual: Callable[[np.ndarray], np.ndarray], relative_step: float = 1e-7
+                       ) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+    """``fun`` for :func:`damped_newton` from a residual alone: its Jacobian by
+    forward differences, column j stepped by ``relative_step`` max(1, |x_j|)."""
+    def fun(x):
+        r = residual(x)
+        jac = np.empty((r.size, x.size))
+        for j in range(x.size):
+            dx = np.zeros_like(x)
+            dx[j] = relative_step * max(1.0, abs(x[j]))
+            jac[:, j] = (residual(x + dx) - r) / dx[j]
+        return r, jac
+    return fun
+
+
+class NewtonCache:
+    """CasADi rootfinders (z0, q) -> z of one residual R(z, q) = 0, built once
+    per (tolerance, max_iter, error_on_fail): Newton with line search;
+    ``error_on_fail`` raises instead of returning the last iterate (inside an
+    NLP, where Ipopt then shortens its step). ``jacobian``: a function
+    making (z, q) -> (∂R/∂z, R), to use at every Newton step instead of
+    CasADi's own (e.g. a compiled one, design/solvers/compiled.py: the same
+    operations, so the same iterates), made when the first rootfinder is."""
+
+    def __init__(self, name: str, residual: ca.Function, linear_solver: str,
+                 jacobian: Callable[[], ca.Function] | None = None):
+        self.name, self.residual, self.linear_solver = name, residual, linear_solver
+        self._make_jacobian, self._jacobian = jacobian, None
+        self._built: dict = {}
+
+    def get(self, tolerance: float, max_iter: int, error_on_fail: bool,
+            use_jacobian: bool = True) -> ca.Function:
+        """The rootfinder; ``use_jacobian`` false: with CasADi's own Jacobian
+        even when a ``jacobian`` was given (no compiling for it)."""
+        key = (tolerance, max_iter, error_on_fail, use_jacobian)
+        if key not in self._built:
+            opts = {"abstol": tolerance, "max_iter": max_iter, "error_on_fail": error_on_fail,
+                    "line_search": True, "linear_solver": self.linear_solver,
+                    "show_eval_warnings": False}
+            if self._make_jacobian is not None and use_jacobian:
+                if self._jacobian is None:
+                    self._jacobian = self._make_jacobian()
+                opts["jacobian_function"] = self._jacobian
+            self._built[key] = ca.rootfinder(self.name, "newton", self.residual, opts)
+        return self._built[key]
+
+
+def implicit_rate(jz: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """The rates ż of a root of R(z, q) = 0 from jz ż = rhs (the implicit-function
+    theorem, rhs = -∂R/∂q q̇): LU, an order of magnitude faster than least
+    squares at a contact's size; where jz is singular (a fold), the
+    least-squares minimum-norm rates."""
+    try:
+        return np.linalg.solve(jz, rhs)
+    except np.linalg.LinAlgError:
+        return np.linalg.lstsq(jz, rhs, rcond=None)[0]
+
+
+def compiled_jacobian(residual: ca.Function, name: str) -> ca.Function:
+    """(z, q) -> (∂R/∂z, R) of an SX residual R(z, q) for the Newton steps,
+    compiled when a compiler is there (design/solvers/compiled.py; the same
+    operations as CasADi's own, so the same iterates to the last bit)."""
+    from design.solvers.compiled import compiled
+    z = ca.SX.sym("z", residual.size1_in(0))
+    q = ca.SX.sym("q", residual.size1_in(1))
+    r = residual(z, q)
+    return compiled([ca.Function(name, [z, q], [ca.jacobian(r, z), r])]).functions[0]
+
+
+class Chord:
+    """Newton's method with the Jacobian of a nearby solution (the chord
+    method), for the many short continuation steps of a simulation: each
+    iteration is one residual evaluation (compiled where a compiler is,
+    design/solvers/compiled.py) and one product with the inverse Jacobian
+    kept from that solution, instead of a Jacobian and its factorisation.
+    It converges linearly, fast while the Jacobian has changed little; the
+    caller falls back to Newton where it does not converge within the
+    iterations allowed. The root it converges to satisfies the same
+    tolerance as Newton's."""
+
+    def __init__(self, residual: ca.Function):
+        from design.solvers.buffers import Buffered
+        from design.solvers.compiled import compiled
+        self._residual = Buffered(compiled([residual]).functions[0])
+        z = ca.SX.sym("z", residual.size1_in(0))
+        q = ca.SX.sym("q", residual.size1_in(1))
+        self._jacobian = Buffered(ca.Function(f"{residual.name()}_dense_jz", [z, q],
+                                              [ca.densify(ca.jacobian(residual(z, q), z))]))
+
+    def inverse(self, z: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+        """∂R/∂z inverted at (z, q); None where it is singular."""
+        try:
+            return np.linalg.inv(self._jacobian(z, q)[0])
+        except np.linalg.LinAlgError:
+            return None
+
+    def solve(self, z0: np.ndarray, q: np.ndarray, inverse: np.ndarray, tolerance: float,
+              max_iter: int) -> np.ndarray | None:
+        """The root from z0 with max |R| ≤ ``tolerance``, or None."""
+        z = np.array(z0, float)
+        for _ in range(max_iter + 1):
+            r = self._residual(z, q)[0].ravel()
+            size = np.max(np.abs(r))
+            if size <= tolerance:
+                return z
+            if not np.isfinite(size):
+                return None
+            z -= inverse @ r
+        return None
