@@ -44,8 +44,8 @@ def main() -> design.DesignResult:
     print(run.verdict)
     series = run.timeseries
     print(f"{len(series['t_s'])} recorded instants; the bird's centre rose "
-          f"{1e3 * (series['Z_m'].max() - series['Z_m'][0]):.1f} mm; finger 4a pressed up to "
-          f"{series['F4a_N'].max():.1f} N")
+          f"{1e3 * (series['Z_m'].max() - series['Z_m'][0]):.1f} mm; finger 4 pressed up to "
+          f"{series['F4_N'].max():.1f} N")
     result = design.solve(PROBLEM)
     print(result.verdict)
     d = result.design                                  # SI: the angle in rad

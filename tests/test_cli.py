@@ -72,7 +72,11 @@ def test_the_package_is_the_api_and_the_version_is_shown(capsys):
     assert done.stdout.split("] ")[1].split() == ["True", "False"]
     for name in ("simulate", "solve", "fit", "check", "animate", "Status", "DesignResult"):
         assert name in done.stdout
-    assert callable(design.simulate) and callable(design.check) and callable(design.animate)
+    import design.calibration.belt                   # the subpackages do not shadow the API
+    import design.solvers.optimize.trust_region
+    from design import api
+    assert (design.simulate, design.solve, design.fit, design.check, design.animate) == \
+        (api.simulate, api.solve, api.fit, api.check, api.animate)
     with pytest.raises(SystemExit) as exit_:
         main(["--version"])
     assert exit_.value.code == 0 and capsys.readouterr().out.strip() == f"design {design.__version__}"
