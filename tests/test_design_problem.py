@@ -133,11 +133,10 @@ def test_a_problem_built_in_python_runs_with_its_files_settings():
     from_dict = design.check({**data, "scene": str(ROOT / "problems" / data["scene"])}).value
     built = DesignProblem(from_file.name, design.check(ROOT / "problems" / data["scene"]).value,
                           from_file.variables, from_file.caps, from_file.rules,
-                          {"time_step": 0.01, "max_iter": 40, "outer_iterations": 6,
-                           "trust_region": 0.15}, model_check="none", robustness=True)
+                          dict(data["solver"]), model_check="none", robustness=True)
     assert built.settings == from_file.settings == from_dict.settings
     assert built == replace(from_file, description="")
     loop, scene = from_file.settings, from_file.scene.settings
     assert loop.nlp.beam_intervals == loop.contact_nodes == scene.contact_nodes
-    assert loop.simulator.max_step == loop.nlp.time_step == 0.01
+    assert loop.simulator.max_step == loop.nlp.time_step == data["solver"]["time_step"]
     assert loop.simulator.rtol < scene.integrator.rtol
