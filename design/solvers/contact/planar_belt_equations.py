@@ -39,7 +39,6 @@ from __future__ import annotations
 from functools import cached_property
 
 import casadi as ca
-import numpy as np
 
 from design.physics.ellipse import gradient_conic, level_conic
 from design.physics.stiffness import Stiffness

@@ -15,8 +15,8 @@ import numpy as np
 
 from design.physics.rod import quaternion_rotation
 from design.solvers.beam.collocation import legendre_tables
-from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, EVENT_DEPTH,
-                                                    Belted, BeltedContact, Plane)
+from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belted,
+                                                    BeltedContact, Plane)
 from design.solvers.contact.robust import BASE_FRACTION
 from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, SpatialState, grazing_shift,

@@ -47,8 +47,7 @@ import casadi as ca
 import numpy as np
 
 from design.solvers.beam.rod import RodStiffness, rod_transcription
-from design.solvers.contact.spatial_equations import FRICTION, QUADRIC, friction_vector, \
-    quadric_matrix
+from design.solvers.contact.spatial_equations import FRICTION, friction_vector, quadric_matrix
 from design.solvers.newton import Chord, NewtonCache, compiled_jacobian
 
 #: index of the belt plane (n, e) and of its friction law in q
