@@ -47,7 +47,6 @@ def _prefetch_jobs(session) -> list:
     from tests.design_cases import (COMPILE, compile_finger_loads, prefetch_jobs,
                                     prefetched_simulation)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
-    from tests.test_design_solve import SETTINGS
     from tests.test_grasp import HARD, HARD_FINE, hard_run
     from tests.test_population import TWINS, solve_twins
     from tests.test_reports import DESIGN_RUN, solve_short_design
@@ -72,7 +71,7 @@ def _prefetch_jobs(session) -> list:
         jobs.append((COMPILE, compile_finger_loads, (), ()))
     if asked(["tests/test_contact_poses.py::test_imposed_side_matches"]):
         jobs.append((REFERENCES, imposed_side_references, (), ()))
-    simulations = prefetch_jobs(SETTINGS)
+    simulations = prefetch_jobs()
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
     # tests/test_grasp.py's two runs, asked for before test_reports' design run

@@ -30,10 +30,21 @@ from design.io.scene_writer import grasp_spec
 from design.reproduce.grasp import advanced, load_model, thesis_setup
 from design.solvers.grasp import simulation
 from design.solvers.grasp.integrate import IntegratorSettings
+from design.solvers.optimize.policy import loop_settings
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR
 from design.solvers.optimize.variables import DesignSpace, Variable, timed_conveyor
 from tests import prefetch
 
 GRASPER = Path(__file__).parent / "data" / "one_set_grasper.yaml"
+
+#: the short grasp's scene settings: 6 contact nodes, integrated as the design
+#: loop does (LOOP_SIMULATOR)
+SCENE = GraspSettings(LOOP_SIMULATOR, 6)
+#: the optimiser tests' loop settings: those of a short problem file on a
+#: 10 ms grid, as the solve layer's policy makes them, so that a test calling
+#: the loop's functions and a ``design solve`` of such a file ask for the
+#: same simulations (and verifications) of the short grasp and share them
+LOOP = loop_settings({"time_step": 0.01, "max_iter": 150}, SCENE)
 
 
 def short_setup():
@@ -54,7 +65,7 @@ def short_problem_file(path: Path, variables: dict, model_check: str = "none",
     10 ms grid) to ``path`` (JSON is YAML); ``solver``: further settings.
     No spatial model check unless asked for (12 s CPU of background runs;
     tests/test_reports.py's design run has it)."""
-    scene = grasp_spec(short_setup(), GraspSettings(contact_nodes=6), "short", "")
+    scene = grasp_spec(short_setup(), SCENE, "short", "")
     path.write_text(json.dumps({"kind": "design", "scene": scene, "cap": "baseline",
                                 "variables": variables, "model_check": model_check,
                                 "solver": {"time_step": 0.01, **solver}}))
@@ -82,6 +93,8 @@ def _canonical(value):
         return tuple(_canonical(v) for v in value)
     if isinstance(value, dict):
         return tuple(sorted((repr(k), _canonical(v)) for k, v in value.items()))
+    if isinstance(value, (set, frozenset)):
+        return ("set", tuple(sorted(_canonical(v) for v in value)))
     if isinstance(value, np.ndarray):
         return ("ndarray", value.dtype.str, value.shape, tuple(value.ravel().tolist()))
     if value is None or isinstance(value, (bool, int, float, str, np.number)):
@@ -159,14 +172,14 @@ def asked(call) -> tuple:
     raise RuntimeError("no simulation asked for")
 
 
-def prefetch_jobs(settings) -> list[tuple[str, tuple, list[str]]]:
+def prefetch_jobs() -> list[tuple[str, tuple, list[str]]]:
     """The shared simulations the default run needs, as (key, inputs, the
     tests that ask for them): the short grasp's baseline at the loop's
-    tolerance, its baseline and stiff lower fingers (scale 2) at the
-    verification's 4x finer resolution, the stiff design at the loop's, and
-    the baseline at the scenes' default tolerance. ``settings``: the
-    optimiser tests' LoopSettings (their time step sets the verification's)."""
+    tolerance (:data:`LOOP`), its baseline and stiff lower fingers (scale 2)
+    at the verification's 4x finer resolution, the stiff design at the
+    loop's, and the baseline at the scenes' default tolerance."""
     from design.solvers.optimize.trust_region import simulate, verify
+    settings = LOOP
     space = stiffness_space("lower", hi=2.0)
     base = space.scale(space.base_values)
     design = ["tests/test_design_solve.py::test_verification_catches_a_design_over_the_cap",

@@ -11,11 +11,9 @@ import pytest
 
 from design.solvers.optimize.schedule import schedule_of
 from design.solvers.optimize.transcription import DesignNLP, NLPSettings
-from design.solvers.optimize.trust_region import LoopSettings, simulate
-from tests.design_cases import sharing_simulations, stiffness_space
+from design.solvers.optimize.trust_region import simulate
+from tests.design_cases import LOOP, sharing_simulations, stiffness_space
 
-#: test_design_solve's settings, so that the session shares the simulation
-SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +21,7 @@ def baseline():
     space = stiffness_space("lower", "upper")
     d0 = space.scale(space.base_values)
     with sharing_simulations():
-        run = simulate(space, d0, SETTINGS).run
+        run = simulate(space, d0, LOOP).run
     return space, d0, run
 
 

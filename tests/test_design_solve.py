@@ -16,12 +16,10 @@ import pytest
 from design.cli import main
 from design.solvers.grasp.simulation import simulate_grasp
 from design.solvers.optimize.schedule import schedule_of
-from design.solvers.optimize.transcription import DesignNLP, NLPSettings
-from design.solvers.optimize.trust_region import (LoopSettings, Outcome, optimise, score,
-                                                simulate, verdict, verify)
-from tests.design_cases import sharing_simulations, short_problem_file, stiffness_space
-
-SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
+from design.solvers.optimize.transcription import DesignNLP
+from design.solvers.optimize.trust_region import (Outcome, optimise, score, simulate, verdict,
+                                                verify)
+from tests.design_cases import LOOP, sharing_simulations, short_problem_file, stiffness_space
 
 
 @pytest.fixture
@@ -37,8 +35,8 @@ def test_kkt_conditions_hold_by_finite_differences(shared_simulations):
     a bound active."""
     space = stiffness_space("lower", "upper")
     d0 = space.scale(space.base_values)
-    run = simulate(space, d0, SETTINGS).run
-    nlp = DesignNLP(space, schedule_of(run, 0.01), run, 18.5, SETTINGS.nlp,
+    run = simulate(space, d0, LOOP).run
+    nlp = DesignNLP(space, schedule_of(run, 0.01), run, 18.5, LOOP.nlp,
                     box=(np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1)))
     r = nlp.solve()
     assert r.success, r.status
@@ -92,11 +90,11 @@ def test_one_variable_optimum_matches_exhaustive_search(shared_simulations):
     design within 0.01)."""
     space = stiffness_space("upper")
     grid = np.linspace(0.3, 0.5, 9)                 # scales 0.80 ... 1.00
-    holds = [simulate(space, [d], SETTINGS).hold for d in grid]
+    holds = [simulate(space, [d], LOOP).hold for d in grid]
     best = int(np.argmax(holds))
     assert 0 < best < grid.size - 1                 # an interior optimum
-    out = optimise(space, 100.0, LoopSettings(nlp=replace(SETTINGS.nlp, max_iter=40),
-                                              outer_iterations=3))
+    out = optimise(space, 100.0, replace(LOOP, nlp=replace(LOOP.nlp, max_iter=40),
+                                    outer_iterations=3))
     scale = space.design(out.best.d)["groups.upper.stiffness_scale"]
     assert out.best.hold >= max(holds) - 1e-3
     assert abs(scale - (0.5 + grid[best])) <= 0.05
@@ -108,8 +106,8 @@ def test_verification_catches_a_design_over_the_cap(shared_simulations):
     (The next test's ``design solve`` verifies the same two designs with the
     same settings, so these runs serve both.)"""
     space = stiffness_space("lower", hi=2.0)
-    baseline = verify(space, space.scale(space.base_values), SETTINGS)
-    stiff = verify(space, [1.0], SETTINGS)                       # scale 2
+    baseline = verify(space, space.scale(space.base_values), LOOP)
+    stiff = verify(space, [1.0], LOOP)                       # scale 2
     assert stiff.peak > 1.05 * baseline.peak
     failed = verdict(stiff.hold, stiff, baseline.peak)
     assert not failed["passed"] and failed["max_finger_force_N"] > failed["cap_N"] * 1.01
@@ -156,7 +154,7 @@ def test_the_nlp_cap_starts_below_the_cap_and_closes_on_it(monkeypatch, shared_s
         raise RuntimeError("no NLP in this test")
 
     monkeypatch.setattr("design.solvers.optimize.trust_region.DesignNLP", no_nlp)
-    out = optimise(stiffness_space("upper"), 20.0, LoopSettings(nlp=SETTINGS.nlp, cap_margin=0.2))
+    out = optimise(stiffness_space("upper"), 20.0, replace(LOOP, cap_margin=0.2))
     assert asked == pytest.approx([16.0, 18.0, 19.0, 19.5])
     assert [i["error"] for i in out.iterations] == ["no NLP in this test"] * 4
     assert out.best is out.baseline
@@ -205,4 +203,4 @@ def test_a_baseline_that_turns_the_bird_over_is_refused_by_name():
     schedule = schedule_of(run, 0.01)
     assert max(abs(s[2]) for p in schedule.phases for s in p.states) > MAX_PITCH
     with pytest.raises(ValueError, match="turns over inside the optimiser's window"):
-        DesignNLP(space, schedule, run, 100.0, SETTINGS.nlp)
+        DesignNLP(space, schedule, run, 100.0, LOOP.nlp)

@@ -21,12 +21,10 @@ from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, sta
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.schedule import schedule_of
 from design.solvers.optimize.transcription import DesignNLP, NLPSettings
-from design.solvers.optimize.trust_region import LoopSettings, simulate
+from design.solvers.optimize.trust_region import simulate
 from tests import prefetch
-from tests.design_cases import sharing_simulations, stiffness_space
+from tests.design_cases import LOOP, sharing_simulations, stiffness_space
 
-#: test_design_solve's settings, so that the session shares the simulation
-SETTINGS = LoopSettings(nlp=NLPSettings(time_step=0.01, max_iter=150))
 NLP = NLPSettings(time_step=0.01, max_iter=60)
 
 
@@ -40,7 +38,7 @@ def solve_twins() -> dict:
     space = stiffness_space("lower", "upper")
     d0 = space.scale(space.base_values)
     with sharing_simulations():
-        run = simulate(space, d0, SETTINGS).run
+        run = simulate(space, d0, LOOP).run
     # a cap and box where the single NLP converges (in 15 iterations): at
     # tighter caps or wider boxes it stops at its iteration limit, and two
     # unconverged solves need not agree

@@ -21,15 +21,14 @@ import pytest
 from design.cli import main
 from design.solvers.optimize.profile import (IPOPT, OPTIMISER, UNACCOUNTED, VIEWS, Profile,
                                            profile_rows)
-from design.solvers.optimize.trust_region import LOOP_SIMULATOR
-from tests.design_cases import shared_simulate_grasp, short_problem_file, short_setup
+from tests.design_cases import LOOP, shared_simulate_grasp, short_problem_file, short_setup
 
 
 @pytest.fixture(scope="module")
 def solved(tmp_path_factory):
     """result.json and report.html of the short design solve."""
     tmp = tmp_path_factory.mktemp("profile")
-    run = shared_simulate_grasp(short_setup(), LOOP_SIMULATOR)
+    run = shared_simulate_grasp(short_setup(), LOOP.simulator)
     path = short_problem_file(tmp / "problem.yaml",
                               {"groups.upper.stiffness_scale": [0.5, 1.5]},
                               max_iter=2, outer_iterations=1, time_step=0.02)

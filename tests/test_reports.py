@@ -23,8 +23,7 @@ from design.run import RunOutput
 from design.solvers.contact.spatial import Quadric, SpatialContact
 from design.solvers.grasp.fingers import FingerState
 from design.solvers.optimize.model_check import compare
-from design.solvers.optimize.trust_region import LOOP_SIMULATOR
-from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
+from tests.design_cases import LOOP, shared_simulate_grasp, sharing_simulations, short_setup
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
 PNG = b"\x89PNG\r\n\x1a\n"
@@ -133,10 +132,10 @@ GRASP_FIGURES = ["fig-layout", "fig-path", "fig-normal_force", "fig-finger_force
 
 def short_scene(tmp_path) -> Path:
     """The short grasp as a scene file integrated as the design loop does
-    (LOOP_SIMULATOR), so that its simulation is also the design run's and
+    (LOOP.simulator), so that its simulation is also the design run's and
     the optimiser tests' baseline: one run for all (tests/design_cases.py)."""
     path = tmp_path / "short.yaml"
-    path.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(LOOP_SIMULATOR, 6),
+    path.write_text(scene_yaml(grasp_spec(short_setup(), GraspSettings(LOOP.simulator, 6),
                                           "short", "the short grasp")))
     return path
 
@@ -265,7 +264,7 @@ def test_design_report_draws_the_pareto_curve(design_run, tmp_path):
     result["pareto"] = [{"cap_N": c, "status": "verified", "optimiser_hold_time_s": h,
                          "verified_hold_time_s": h, "verified_max_finger_force_N": c - 1,
                          "passed": True} for c, h in [(10.0, 0.1), (12.0, 0.2)]]
-    run = shared_simulate_grasp(short_setup(), LOOP_SIMULATOR)
+    run = shared_simulate_grasp(short_setup(), LOOP.simulator)
     write_report(tmp_path, design_page(result, run, run))
     r = read(tmp_path)
     assert "pareto" in r.sections and "fig-pareto" in r.figures

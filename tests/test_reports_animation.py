@@ -20,8 +20,7 @@ from design.report.video import write_video
 from design.report.viewer import animation_html
 from design.run.animation import MAX_FRAMES, STATE, animation_record, frame_states, frame_step
 from design.run.grasp import timeseries
-from design.solvers.optimize.trust_region import LOOP_SIMULATOR
-from tests.design_cases import shared_simulate_grasp, sharing_simulations, short_setup
+from tests.design_cases import LOOP, shared_simulate_grasp, sharing_simulations, short_setup
 from tests.test_reports import short_scene
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
@@ -32,7 +31,7 @@ REPORT_BUDGET = 8e6
 @pytest.fixture(scope="module")
 def short_run():
     """The short grasp, the design tests' shared baseline run."""
-    return shared_simulate_grasp(short_setup(), LOOP_SIMULATOR)
+    return shared_simulate_grasp(short_setup(), LOOP.simulator)
 
 
 @pytest.fixture(scope="module")
@@ -79,7 +78,7 @@ def test_fingers_solved_again_at_the_recorded_states_give_the_recorded_forces(sh
     contact to the Newton tolerance, continued from different instants)."""
     rows = timeseries(short_run)[::3]
     record = animation_record({"short": (grasp_spec(short_run.setup, GraspSettings(
-        LOOP_SIMULATOR, 6), "short", ""), rows)}, None)
+        LOOP.simulator, 6), "short", ""), rows)}, None)
     from design.io.scene import load_scene
     from design.run.grasp import setup_of
 
