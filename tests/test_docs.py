@@ -14,11 +14,13 @@ LINK = re.compile(r"\]\((?!https?:|#)([^)#\s]+)")
 
 
 def scanned() -> list[Path]:
-    """README, docs and every Python file of the package, its tests, examples
-    and benchmarks (this one aside: it names the words)."""
+    """README, docs, every Python file of the package, its tests, examples
+    and benchmarks (this one aside: it names the words) and every YAML file
+    of theirs and of the models and problems."""
     files = [ROOT / "README.md", *(ROOT / "docs").rglob("*.md"),
-             *(path for folder in ("design", "tests", "examples", "benchmarks")
-               for path in (ROOT / folder).rglob("*.py"))]
+             *(path for folder in ("design", "tests", "examples", "benchmarks", "models",
+                                   "problems")
+               for pattern in ("*.py", "*.yaml") for path in (ROOT / folder).rglob(pattern))]
     return [f for f in files if f != Path(__file__).resolve()]
 
 
