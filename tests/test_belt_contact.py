@@ -252,3 +252,29 @@ def test_a_continued_state_is_the_fresh_one():
     fresh, _ = spatial.solve(None, FrictionLaw(), plane, spatial_law(MU))
     assert isinstance(near, Belted)
     assert continued.belt_normal_force == pytest.approx(fresh.belt_normal_force, rel=1e-10)
+
+
+def test_a_bird_between_the_finger_s_nodes_is_touched():
+    """The spatial finger on the belt, three intervals as the chapter V runs
+    mesh it (its nodes up to 31 mm apart), and a ball that dips between two
+    nodes, half as deep as it could without reaching them: the finger touches
+    the ball where it enters it, continued from the finger on the belt or
+    afresh, rather than passing through it."""
+    finger = Finger(LENGTH, thesis_finger().stiffness)
+    spatial = SpatialBeltContact(SpatialContact(finger, intervals=3))
+    plane = Plane(np.array([*NORMAL, 0.0]), belt_offset(7.3e-3))
+    on_belt, resting = spatial.solve(None, FrictionLaw(), plane, spatial_law(MU))
+    pts = on_belt.shape_points
+    gaps = np.linalg.norm(np.diff(pts, axis=1), axis=0)
+    k = int(np.argmax(gaps))
+    chord = (pts[:, k + 1] - pts[:, k]) / gaps[k]
+    radius = 0.05
+    dip = 0.5 * (gaps[k] / 2) ** 2 / (2 * radius)
+    ball = Quadric(0.5 * (pts[:, k] + pts[:, k + 1]) + (radius - dip) * np.cross([0, 0, 1.0], chord),
+                   np.eye(3) / radius ** 2)
+    assert ball.level(pts).min() > 0.0
+    for previous in (resting, None):
+        sol, state = spatial.solve(ball, FrictionLaw(), plane, spatial_law(MU), previous)
+        assert sol.converged and state.mode == "interior+belt", sol.message
+        assert sol.normal_force > 0.0 and sol.belt_normal_force > 0.0
+        assert sol.arc_length == pytest.approx(LENGTH * 0.7, abs=0.02)

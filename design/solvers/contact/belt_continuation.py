@@ -52,6 +52,36 @@ BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
 BELT_MODES = ("belt", "tip+belt", "interior+belt")
 
 
+def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
+            matrix: np.ndarray) -> tuple[float, float]:
+    """The lowest level (r - c)ᵀ M (r - c) - 1 of the bird (centre c, matrix
+    M) along the finger's centreline, not only at its points: the curve
+    through ``points`` (dim, n; m, base to tip) with unit ``tangents``
+    (dim, n) there, each gap a cubic Hermite arc. Returns the level and where
+    it lies, as a fraction of the centreline's length. Between the points a
+    convex bird can cross the chord unseen."""
+    rel = points - center[:, None]
+    chords = np.linalg.norm(np.diff(points, axis=1), axis=0)
+    p0, p1 = rel[:, :-1], rel[:, 1:]
+    m0, m1 = chords * tangents[:, :-1], chords * tangents[:, 1:]
+    # r(s) = Σ_i a_i s^i over each gap, s in [0, 1]; the level is Σ_ij a_iᵀ M a_j s^(i+j) - 1
+    a = np.stack([p0, m0, 3 * (p1 - p0) - 2 * m0 - m1, 2 * (p0 - p1) + m0 + m1])
+    gram = np.einsum("ikn,kl,jln->nij", a, matrix, a)
+    coef = np.zeros((chords.size, 7))
+    for i in range(4):
+        for j in range(4):
+            coef[:, i + j] += gram[:, i, j]
+    coef[:, 0] -= 1.0
+    grid = np.linspace(0.0, 1.0, 9)
+    k = int(np.argmin(np.min(np.polynomial.polynomial.polyval(grid, coef.T), axis=1)))
+    poly = np.polynomial.Polynomial(coef[k])
+    s = np.concatenate([[0.0, 1.0], [r.real for r in poly.deriv().roots()
+                                     if abs(r.imag) < 1e-12 and 0.0 < r.real < 1.0]])
+    values = poly(s)
+    best = int(np.argmin(values))
+    return float(values[best]), float((chords[:k].sum() + chords[k] * s[best]) / chords.sum())
+
+
 @dataclass(frozen=True)
 class Plane:
     """The belt in a finger frame: n·r = e, n its upward unit normal (3,
@@ -236,7 +266,9 @@ class BeltedContact:
             if kind == "base":
                 return "base"
             if kind == "release-bird" and touched is not None:
-                return replace(touched, graze=GRAZE_DEPTH)  # a first touch that pulls
+                # a first touch that pulls grazes; one that pulls again has no
+                # contact to follow here
+                return replace(touched, graze=GRAZE_DEPTH) if touched.graze == 0.0 else None
             if depth > EVENT_DEPTH and h > EVENT_STEP and kind in ("bird", "belt"):
                 return "locate", kind, depth
             switched = self.switch(new, kind)

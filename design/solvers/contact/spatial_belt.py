@@ -15,8 +15,9 @@ import numpy as np
 
 from design.physics.rod import quaternion_rotation
 from design.solvers.beam.collocation import legendre_tables
+from design.solvers.beam.rod import N_STATE
 from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belted,
-                                                    BeltedContact, Plane)
+                                                    BeltedContact, Plane, deepest)
 from design.solvers.contact.robust import BASE_FRACTION
 from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, SpatialState, grazing_shift,
@@ -52,7 +53,7 @@ class SpatialBeltContact(BeltedContact):
         self.n_rod = rod.n_w
         self.tr = {m: belt_transcription(contact.stiffness, rod.K, rod.d, m) for m in BELT_MODES}
         self.n_over = self.tr["interior+belt"].overhang.n_w
-        self.tau = legendre_tables(rod.d)[0]
+        self.tau, _, self.ends = legendre_tables(rod.d)[:3]
 
     # ----------------------------------------------------------------- API
     def solve(self, quadric: Quadric | None, friction, plane: Plane, belt,
@@ -188,11 +189,21 @@ class SpatialBeltContact(BeltedContact):
         rest = np.linspace(0.0, self.length - post[4], 6)[1:]
         return np.hstack([r, post[:3, None] + post[13:16, None] * rest[None, :]])
 
+    def _tangents(self, state: Belted) -> np.ndarray:
+        """The unit tangents d1 (3, n) at :meth:`_points` of a ``belt`` state:
+        its nodes' quaternions, the tip's by the last interval's end values."""
+        nodes = state.z[:self.n_rod].reshape(-1, N_STATE)[:, :4]
+        quats = np.vstack([nodes, self.ends @ nodes[-self.tau.size:]])
+        return np.column_stack([quaternion_rotation(q)[:, 0] for q in quats])
+
     def _bird_depth(self, state: Belted) -> float:
         """How deep the finger (not touching the bird) is inside it (m; ≤ 0 outside)."""
         quadric = Quadric.from_params(state.bird)
         if state.mode == "free":
             level = segment_level(quadric, self.length)
+        elif state.mode == "belt":
+            level = deepest(self._points(state), self._tangents(state), quadric.center,
+                            quadric.matrix)[0]
         else:
             level = float(np.min(quadric.level(self._points(state))))
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
@@ -203,6 +214,10 @@ class SpatialBeltContact(BeltedContact):
         if state.mode == "free":
             graze = grazing_shift(quadric, self.length)
             return None if graze is None else graze[1]
+        if state.mode == "belt":
+            arc = self.length * deepest(self._points(state), self._tangents(state),
+                                        quadric.center, quadric.matrix)[1]
+            return arc if arc > BASE_FRACTION * self.length else None
         pts = self._points(state)
         arcs = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=1), axis=0))])
         arcs *= self.length / arcs[-1]
