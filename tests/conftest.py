@@ -47,7 +47,9 @@ def _prefetch_jobs(session) -> list:
     from tests.design_cases import (COMPILE, compile_finger_loads, prefetch_jobs,
                                     prefetched_simulation)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
+    from tests.test_fit_bench import MOULDED, moulded_fit
     from tests.test_grasp import HARD, HARD_FINE, hard_run
+    from tests.test_peaks import RUNS, peak_runs
     from tests.test_population import TWINS, solve_twins
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
@@ -74,11 +76,15 @@ def _prefetch_jobs(session) -> list:
     simulations = prefetch_jobs()
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
+    if fixture_used("moulded_finger"):
+        jobs.append((MOULDED, moulded_fit, (folder("moulded"),), ()))
     # tests/test_grasp.py's two runs, asked for before test_reports' design run
     if fixture_used("hard_fine"):
         jobs.append((HARD_FINE, hard_run, (4.0,), ()))
     if fixture_used("hard"):
         jobs.append((HARD, hard_run, (), ()))
+    if asked(["tests/test_peaks.py::test_locat"]):
+        jobs.append((RUNS, peak_runs, (), ()))
     if fixture_used("twins"):
         # after the short grasp's baseline at the loop's tolerance, which it uses
         jobs.append((TWINS, solve_twins, (), (simulations[0][0],)))

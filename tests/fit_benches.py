@@ -160,7 +160,7 @@ FAMILY = {b.name: b for b in (
     Bench("insert-40", 0.120, LogProfile(0.085, 0.0, ((-np.log(6), 0.048, 0.003),)), 15,
           "a stiff insert over the first 40 %: EI 6x the rest's, ending over 6 mm"),
     Bench("taper-30", 0.150, LogProfile(0.18, np.log(30) / 0.150), 21,
-          "exponential taper, EI(0)/EI(L) = 30 (the issue's moulded finger)"),
+          "exponential taper, EI(0)/EI(L) = 30 (a moulded finger)"),
     Bench("insert", 0.120, LogProfile(0.144, 0.0, ((-np.log(8), 0.040, 0.002),)), 22,
           "a stiff insert over the first third: EI 8x the rest's, ending over 4 mm"),
     Bench("thickness-50", 0.150, ThicknessTaper(0.16, 50.0, 0.150), 23,

@@ -21,8 +21,8 @@ The tapers meet them all. On the other profiles (thickness falling as
 ±25 % at most knots, so little or nothing is claimed, and the tests ask
 that what is claimed holds.
 
-The default suite runs one fit, the issue's moulded finger through the
-command's run; ``-m slow`` runs the whole family with each kind of reading (48
+The default suite runs one fit, a moulded finger (taper-30) through the
+command's run, computed ahead by the prefetch worker (tests/prefetch.py); ``-m slow`` runs the whole family with each kind of reading (48
 fits, about five minutes), and benchmarks/fit_bench.py tabulates it with
 times.
 """
@@ -39,6 +39,7 @@ import pytest
 from design.io.scene import load_fit
 from design.run.finger_fit import fit_finger, summarise
 from design.run.fit import run
+from tests import prefetch
 from tests.fit_benches import FAMILY, READINGS, readings, score, write_problem
 
 
@@ -57,14 +58,26 @@ def assert_recovered(name: str, knots, ei, low, high, determined, noise_scale, m
     assert abs(noise_scale - 1) <= noise_bound(m), noise_scale
 
 
-@pytest.fixture(scope="module")
-def moulded_finger(tmp_path_factory):
-    """The issue's moulded finger (150 mm, EI falling 30x) read for x and y,
-    through ``design fit``'s run (the command's exit status is its ``ok``):
-    the result and the data file."""
-    path = write_problem(tmp_path_factory.mktemp("moulded"), "taper-30")
+#: the prefetch worker's key for :func:`moulded_fit` (tests/prefetch.py)
+MOULDED = "tests/test_fit_bench.py: the moulded finger's fit"
+
+
+def moulded_fit(folder: Path) -> tuple[bool, dict, str]:
+    """A moulded finger (150 mm, EI falling 30x) read for x and y, written to
+    ``folder`` and fitted through ``design fit``'s run (the command's exit
+    status is its ``ok``): the result and the data file."""
+    path = write_problem(folder, "taper-30")
     output = run(load_fit(path))
     return output.ok, output.result, path.with_suffix(".csv").read_text()
+
+
+@pytest.fixture(scope="module")
+def moulded_finger(tmp_path_factory):
+    """:func:`moulded_fit`, run ahead by the prefetch worker into the folder
+    it was given, or here."""
+    given = prefetch.scheduled(MOULDED)
+    folder = given[0] if given else tmp_path_factory.mktemp("moulded")
+    return prefetch.result(MOULDED, moulded_fit, folder)
 
 
 def test_the_moulded_finger_is_fitted_from_noisy_readings(moulded_finger):

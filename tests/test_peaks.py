@@ -13,6 +13,7 @@ from design.solvers.grasp import peaks
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.peaks import PEAK_RTOL, interpolated_maximum
 from design.solvers.grasp.simulation import simulate_grasp
+from tests import prefetch
 from tests.problems import thesis_grasp_setup
 
 
@@ -41,8 +42,17 @@ def test_a_smooth_maximum_to_the_tolerance_and_a_kink_never_below_the_bracket():
     assert g(0.4) <= v <= 5.0 and v == g(t)
 
 
+#: the prefetch worker's key for :func:`peak_runs` (tests/prefetch.py)
+RUNS = "tests/test_peaks.py: the hard mean bird with and without located peaks"
+
+
 @pytest.fixture(scope="module")
 def runs():
+    """:func:`peak_runs`, computed ahead by the prefetch worker or here."""
+    return prefetch.result(RUNS, peak_runs)
+
+
+def peak_runs() -> tuple:
     """The hard-finger mean bird over 0.4 s at the default 10 ms steps, with
     and without locating the maxima, and at 1.25 ms."""
     setup = thesis_grasp_setup(0.0, 0.4, "hard")

@@ -24,7 +24,7 @@ from tests.design_cases import LOOP, shared_simulate_grasp, sharing_simulations,
 from tests.test_reports import short_scene
 
 PROBLEMS = Path(__file__).parent.parent / "problems"
-#: the report's budget for a 2 s run (the issue's), bytes
+#: the report's budget for a 2 s run, bytes
 REPORT_BUDGET = 8e6
 
 
