@@ -10,7 +10,7 @@ design variables (scaled to their boxes) and verified hold are compared
 with the first run's: they should agree within 1e-3 and 1 ms. Prints a table
 and writes benchmarks/results/reproducible.json.
 
-    python -m benchmarks.reproducible [PROBLEM] [--workers 2]
+    python -m benchmarks.reproducible [PROBLEM] [--workers 2] [--keep DIR]
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import numpy as np
 import yaml
 
 from benchmarks.results_file import write_results
+from design.io.files import resolve
 
 ROOT = Path(__file__).resolve().parents[1]
 #: (label, environment changes, perturb the baseline)
@@ -44,16 +45,19 @@ DESIGN_TOLERANCE, HOLD_TOLERANCE = 1e-3, 1e-3
 def perturbed(problem: Path, folder: Path) -> Path:
     """The problem with its scene's finger 4 turned by 1e-9 of its angle."""
     data = yaml.safe_load(problem.read_text())
-    scene_path = (problem.parent / data["scene"]).resolve()
+    scene_path = resolve(data["scene"], problem.parent)
     scene = yaml.safe_load(scene_path.read_text())
-    grasper = yaml.safe_load((scene_path.parent / scene["grasper"]).read_text())
+
+    def found(reference: str) -> str:               # as the toolkit finds a model file
+        return str(resolve(reference, scene_path.parent))
+
+    grasper = yaml.safe_load(Path(found(scene["grasper"])).read_text())
     angle = next(f["angle"] for f in grasper["fingers"] if str(f["name"]) == "4")
     degrees = float(str(angle).split()[0])
     for key in ("grasper", "bird", "conveyor"):
-        scene[key] = str((scene_path.parent / scene[key]).resolve())
+        scene[key] = found(scene[key])
     if "finger_models" in scene:
-        scene["finger_models"] = {g: str((scene_path.parent / f).resolve())
-                                  for g, f in scene["finger_models"].items()}
+        scene["finger_models"] = {g: found(f) for g, f in scene["finger_models"].items()}
     scene["mounts"] = {"4": {"angle": f"{degrees * (1 + 1e-9)!r} deg"}}
     data["scene"] = scene
     out = folder / problem.name
@@ -86,10 +90,12 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("problem", nargs="?", default=str(ROOT / "problems" / "hold_time.yaml"))
     parser.add_argument("--workers", type=int, default=1)
+    parser.add_argument("--keep", type=Path, help="keep every run's output folder here")
     args = parser.parse_args()
     problem = Path(args.problem).resolve()
     with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
+        folder = Path(tmp) if args.keep is None else args.keep.resolve()
+        folder.mkdir(parents=True, exist_ok=True)
         jobs = [(perturbed(problem, folder) if perturb else problem, label, changes)
                 for label, changes, perturb in VARIATIONS]
         with ThreadPoolExecutor(args.workers) as pool:
