@@ -25,7 +25,7 @@ from design.physics.beam import Finger
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
 from design.solvers.contact import RobustContact
-from design.solvers.contact.belt_continuation import Belted, Plane
+from design.solvers.contact.belt_continuation import Belted, Plane, deepest
 from design.solvers.contact.planar_belt import PlanarBeltContact
 from design.solvers.contact.spatial import FrictionLaw, Quadric, SpatialContact
 from design.solvers.contact.spatial_belt import SpatialBeltContact
@@ -278,3 +278,72 @@ def test_a_bird_between_the_finger_s_nodes_is_touched():
         assert sol.converged and state.mode == "interior+belt", sol.message
         assert sol.normal_force > 0.0 and sol.belt_normal_force > 0.0
         assert sol.arc_length == pytest.approx(LENGTH * 0.7, abs=0.02)
+
+
+def test_the_deepest_point_of_a_straight_finger_is_found_between_its_nodes():
+    """A straight centreline with nodes at its ends and a circle of radius r
+    dipping d below it at 40 % of its length: the lowest level ((r - d) / r)²
+    - 1 at that place, where the nodes both lie outside the circle."""
+    length, r, d = 0.15, 0.05, 2e-3
+    points = np.array([[0.0, length], [0.0, 0.0]])
+    tangents = np.array([[1.0, 1.0], [0.0, 0.0]])
+    center = np.array([0.4 * length, r - d])
+    found = deepest(points, tangents, center, np.eye(2) / r ** 2)
+    assert found.level == pytest.approx(((r - d) / r) ** 2 - 1, rel=1e-12)
+    assert found.fraction == pytest.approx(0.4, abs=1e-12)
+    np.testing.assert_allclose(found.point, [0.4 * length, 0.0], atol=1e-15)
+    np.testing.assert_allclose(found.tangent, [1.0, 0.0], atol=1e-15)
+    assert np.min(np.sum((points - center[:, None]) ** 2, axis=0)) > r ** 2
+
+
+
+def test_the_deepest_point_of_a_bent_finger_is_the_hermite_curve_s():
+    """Four points on a circular arc (radius 0.2 m) with their tangents and
+    an ellipse (50 x 30 mm, turned 0.3 rad) dipping about 1 mm below the arc
+    30 % into the second gap: the level and place are those of scipy's
+    CubicHermiteSpline through the same points and tangents, sampled at
+    2e5 points (to 1e-9 in level, 1e-5 of the length)."""
+    from scipy.interpolate import CubicHermiteSpline
+
+    angles = np.array([0.0, 0.25, 0.5, 0.75])
+    points = 0.2 * np.array([np.sin(angles), 1.0 - np.cos(angles)])
+    tangents = np.array([np.cos(angles), np.sin(angles)])
+    chords = np.linalg.norm(np.diff(points, axis=1), axis=0)
+    t = np.concatenate([[0.0], np.cumsum(chords)])
+    curve = CubicHermiteSpline(t, points.T, tangents.T)
+    place = t[1] + 0.3 * chords[1]
+    turn = np.array([[np.cos(0.3), -np.sin(0.3)], [np.sin(0.3), np.cos(0.3)]])
+    matrix = turn @ np.diag([1 / 0.05 ** 2, 1 / 0.03 ** 2]) @ turn.T
+    normal = np.array([-curve(place, 1)[1], curve(place, 1)[0]])
+    centre = curve(place) - normal / np.linalg.norm(normal) * (0.03 - 1e-3)
+    found = deepest(points, tangents, centre, matrix)
+    dense = np.linspace(0.0, t[-1], 200001)
+    d = curve(dense) - centre
+    levels = np.einsum("ni,ij,nj->n", d, matrix, d) - 1.0
+    assert found.level == pytest.approx(levels.min(), abs=1e-9)
+    assert found.fraction == pytest.approx(dense[np.argmin(levels)] / t[-1], abs=1e-5)
+    np.testing.assert_allclose(found.point, curve(dense[np.argmin(levels)]), atol=1e-5)
+
+
+def test_the_planar_finger_on_the_belt_touches_a_bird_between_its_nodes():
+    """The planar counterpart of the spatial test above: the thesis finger on
+    the belt, meshed with three intervals, and a disc dipping half as deep
+    as it could between the two nodes farthest apart without reaching them:
+    the finger touches it inside its span, continued or afresh."""
+    finger = Finger(LENGTH, thesis_finger().stiffness)
+    planar = PlanarBeltContact(RobustContact(finger, MU, intervals=3))
+    plane = Plane(NORMAL, belt_offset(7.3e-3))
+    on_belt, resting = planar.solve(None, 0.0, plane, planar_law(MU))
+    pts = np.vstack([on_belt.shape_x, on_belt.shape_y])
+    gaps = np.linalg.norm(np.diff(pts, axis=1), axis=0)
+    k = int(np.argmax(gaps))
+    chord = (pts[:, k + 1] - pts[:, k]) / gaps[k]
+    radius = 0.05
+    dip = 0.5 * (gaps[k] / 2) ** 2 / (2 * radius)
+    centre = 0.5 * (pts[:, k] + pts[:, k + 1]) + (radius - dip) * np.array([-chord[1], chord[0]])
+    disc = (centre, np.eye(2) / radius ** 2)
+    assert np.min(np.sum((pts - centre[:, None]) ** 2, axis=0)) > radius ** 2
+    for previous in (resting, None):
+        sol, state = planar.solve(disc, 0.0, plane, planar_law(MU), previous)
+        assert sol.converged and state.mode == "interior+belt", sol.message
+        assert sol.force > 0.0 and sol.belt_normal_force > 0.0

@@ -32,6 +32,7 @@ on it) is outside the model: it is reported, not corrected.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -52,34 +53,63 @@ BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
 BELT_MODES = ("belt", "tip+belt", "interior+belt")
 
 
+class Deepest(NamedTuple):
+    """Where a finger's centreline goes deepest into the bird: the bird's
+    level (r - c)ᵀ M (r - c) - 1 there (< 0 inside), the place as a fraction
+    of the centreline's length, the point (m) and its unit tangent."""
+
+    level: float
+    fraction: float
+    point: np.ndarray
+    tangent: np.ndarray
+
+
+#: where :func:`deepest` first looks along each gap between a finger's points
+GAP_GRID = np.linspace(0.0, 1.0, 33)
+
+
 def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
-            matrix: np.ndarray) -> tuple[float, float]:
-    """The lowest level (r - c)ᵀ M (r - c) - 1 of the bird (centre c, matrix
-    M) along the finger's centreline, not only at its points: the curve
-    through ``points`` (dim, n; m, base to tip) with unit ``tangents``
-    (dim, n) there, each gap a cubic Hermite arc. Returns the level and where
-    it lies, as a fraction of the centreline's length. Between the points a
-    convex bird can cross the chord unseen."""
+            matrix: np.ndarray) -> Deepest:
+    """The bird's (centre c, matrix M) lowest level along the finger's
+    centreline, not only at its points: the curve through ``points`` (dim,
+    n; m, base to tip) with unit ``tangents`` (dim, n) there, each gap a
+    cubic Hermite arc, its level a degree-6 polynomial in the gap's
+    parameter, minimised on :data:`GAP_GRID` and polished by Newton's
+    method inside the grid cells about the least value (a polynomial's
+    roots are inaccurate when its top coefficients are round-off, as on a
+    straight gap). Between the points a convex bird can cross the chord
+    unseen."""
     rel = points - center[:, None]
     chords = np.linalg.norm(np.diff(points, axis=1), axis=0)
     p0, p1 = rel[:, :-1], rel[:, 1:]
     m0, m1 = chords * tangents[:, :-1], chords * tangents[:, 1:]
-    # r(s) = Σ_i a_i s^i over each gap, s in [0, 1]; the level is Σ_ij a_iᵀ M a_j s^(i+j) - 1
+    # r(s) - c = Σ_i a_i s^i over each gap, s in [0, 1]; the level is Σ_ij a_iᵀ M a_j s^(i+j) - 1
     a = np.stack([p0, m0, 3 * (p1 - p0) - 2 * m0 - m1, 2 * (p0 - p1) + m0 + m1])
     gram = np.einsum("ikn,kl,jln->nij", a, matrix, a)
     coef = np.zeros((chords.size, 7))
     for i in range(4):
-        for j in range(4):
-            coef[:, i + j] += gram[:, i, j]
+        coef[:, i:i + 4] += gram[:, i]
     coef[:, 0] -= 1.0
-    grid = np.linspace(0.0, 1.0, 9)
-    k = int(np.argmin(np.min(np.polynomial.polynomial.polyval(grid, coef.T), axis=1)))
-    poly = np.polynomial.Polynomial(coef[k])
-    s = np.concatenate([[0.0, 1.0], [r.real for r in poly.deriv().roots()
-                                     if abs(r.imag) < 1e-12 and 0.0 < r.real < 1.0]])
-    values = poly(s)
-    best = int(np.argmin(values))
-    return float(values[best]), float((chords[:k].sum() + chords[k] * s[best]) / chords.sum())
+    values = np.polynomial.polynomial.polyval(GAP_GRID, coef.T)
+    k, j = np.unravel_index(int(np.argmin(values)), values.shape)
+    level = np.polynomial.Polynomial(coef[k])
+    slope, curvature = level.deriv(), level.deriv(2)
+    lo, hi = GAP_GRID[max(j - 1, 0)], GAP_GRID[min(j + 1, GAP_GRID.size - 1)]
+    u = GAP_GRID[j]
+    for _ in range(20):
+        if curvature(u) <= 0.0:
+            break
+        step = float(np.clip(u - slope(u) / curvature(u), lo, hi))
+        done, u = step == u, step
+        if done:
+            break
+    if level(u) > values[k, j]:
+        u = GAP_GRID[j]
+    tangent = np.tensordot(np.arange(4) * np.concatenate([[0.0], u ** np.arange(3)]),
+                           a[:, :, k], axes=1)
+    return Deepest(float(level(u)), float((chords[:k].sum() + chords[k] * u) / chords.sum()),
+                   center + np.tensordot(u ** np.arange(4), a[:, :, k], axes=1),
+                   tangent / np.linalg.norm(tangent))
 
 
 @dataclass(frozen=True)

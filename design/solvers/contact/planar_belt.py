@@ -22,7 +22,7 @@ from design.physics.contact import ContactSolution, FingerPose, grazing, straigh
 from design.physics.ellipse import Ellipse
 from design.solvers.beam.collocation import legendre_tables
 from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belted,
-                                                    BeltedContact, Plane)
+                                                    BeltedContact, Deepest, Plane, deepest)
 from design.solvers.contact.planar_belt_equations import (POST_BELT_FORCE, POST_BELT_ON_FINGER,
                                                         POST_TIP, planar_belt_transcription)
 from design.solvers.contact.robust import BASE_FRACTION, RobustContact, _State
@@ -227,12 +227,15 @@ class PlanarBeltContact(BeltedContact):
         t_f = np.array([np.cos(post[2]), np.sin(post[2])])
         return np.hstack([np.vstack([x, y]), post[:2, None] + t_f[:, None] * rest[None, :]])
 
+    def _deepest(self, state: Belted) -> Deepest:
+        """Where a ``belt`` state's finger goes deepest into the bird."""
+        points, tangents = self.calls(state.mode)[2](state.z, self.q(state))
+        return deepest(points, tangents, state.bird[:2], _matrix(state.bird))
+
     def _bird_depth(self, state: Belted) -> float:
         """How deep the finger (not touching the bird) is inside it (m; ≤ 0 outside)."""
-        if state.mode == "free":
-            level = _overlap(state.bird, self.length)
-        else:
-            level = float(np.min(_level(state.bird, self._points(state))))
+        level = _overlap(state.bird, self.length) if state.mode == "free" else \
+            self._deepest(state).level
         B = _matrix(state.bird)
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(B).max()))
 
@@ -247,15 +250,11 @@ class PlanarBeltContact(BeltedContact):
                 return None
             arc, psi, point = graze[1], 0.0, np.array([graze[1], 0.0])
         else:
-            pts = self._points(state)
-            arcs = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=1)))])
-            arcs *= self.length / arcs[-1]
-            k = int(np.argmin(_level(state.bird, pts)))
-            if arcs[k] <= BASE_FRACTION * self.length:
+            found = self._deepest(state)
+            arc, point = found.fraction * self.length, found.point
+            if arc <= BASE_FRACTION * self.length:
                 return None
-            arc, point = float(arcs[k]), pts[:, k]
-            step = pts[:, min(k + 1, pts.shape[1] - 1)] - pts[:, max(k - 1, 0)]
-            psi = float(np.arctan2(step[1], step[0]))
+            psi = float(np.arctan2(found.tangent[1], found.tangent[0]))
             n_f = np.array([-np.sin(psi), np.cos(psi)])
             side = 1 if _gradient(state.bird, point) @ n_f > 0 else -1
         t_f = np.array([np.cos(psi), np.sin(psi)])

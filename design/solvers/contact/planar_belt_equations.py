@@ -74,7 +74,8 @@ class PlanarBeltTranscription:
     ----------
     n_z, n_q : int
     residual, post, shape : casadi.Function
-        ``shape``: (z, q) -> the finger's points (2, n), base to tip (m).
+        ``shape``: (z, q) -> the finger's points (2, n), base to tip (m),
+        and its unit tangents there (2, n).
     """
 
     def __init__(self, stiffness: Stiffness, intervals: int, degree: int, mode: str):
@@ -163,17 +164,19 @@ class PlanarBeltTranscription:
             [ca.vertcat(bird_post, r_t, ca.dot(f_p, n_p), level_p, ca.dot(t_tip, n_p), f_p),
              ca.mmax(ca.fabs(R))])
         if two:
-            _, x1, y1, _, _ = beam.shape(w, ca.vertcat(0.0, 0.0, L, ei_r, widths, ps, 0.0, 0.0))
-            _, x2, y2, _, _ = over.shape(w2, ca.vertcat(0.0, 0.0, L2, ei_r, widths2, ps, L, 0.0))
+            _, x1, y1, a1, _ = beam.shape(w, ca.vertcat(0.0, 0.0, L, ei_r, widths, ps, 0.0, 0.0))
+            _, x2, y2, a2, _ = over.shape(w2, ca.vertcat(0.0, 0.0, L2, ei_r, widths2, ps, L, 0.0))
             c, s = ca.cos(psi_b), ca.sin(psi_b)
             pts = ca.horzcat(ca.horzcat(x1, y1).T,
                              ca.horzcat(r_b[0] + c * x2[1:] - s * y2[1:],
                                         r_b[1] + s * x2[1:] + c * y2[1:]).T)
+            slopes = ca.vertcat(a1, psi_b + a2[1:])
         else:
-            _, x1, y1, _, _ = beam.shape(w, ca.vertcat(0.0, 0.0, length, ei_r, widths, ps, 0.0,
-                                                       0.0))
+            _, x1, y1, slopes, _ = beam.shape(w, ca.vertcat(0.0, 0.0, length, ei_r, widths, ps,
+                                                            0.0, 0.0))
             pts = ca.horzcat(x1, y1).T
-        self.shape = ca.Function(f"{name}_shape", [z, q], [pts])
+        self.shape = ca.Function(f"{name}_shape", [z, q],
+                                 [pts, ca.horzcat(ca.cos(slopes), ca.sin(slopes)).T])
         self._newton = NewtonCache(
             f"{name}_newton", self.residual, "qr",
             lambda: compiled_jacobian(self.residual, f"{self.residual.name()}_jac_z"))

@@ -203,7 +203,7 @@ class SpatialBeltContact(BeltedContact):
             level = segment_level(quadric, self.length)
         elif state.mode == "belt":
             level = deepest(self._points(state), self._tangents(state), quadric.center,
-                            quadric.matrix)[0]
+                            quadric.matrix).level
         else:
             level = float(np.min(quadric.level(self._points(state))))
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
@@ -216,7 +216,7 @@ class SpatialBeltContact(BeltedContact):
             return None if graze is None else graze[1]
         if state.mode == "belt":
             arc = self.length * deepest(self._points(state), self._tangents(state),
-                                        quadric.center, quadric.matrix)[1]
+                                        quadric.center, quadric.matrix).fraction
             return arc if arc > BASE_FRACTION * self.length else None
         pts = self._points(state)
         arcs = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=1), axis=0))])
