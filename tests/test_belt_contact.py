@@ -347,3 +347,10 @@ def test_the_planar_finger_on_the_belt_touches_a_bird_between_its_nodes():
         sol, state = planar.solve(disc, 0.0, plane, planar_law(MU), previous)
         assert sol.converged and state.mode == "interior+belt", sol.message
         assert sol.force > 0.0 and sol.belt_normal_force > 0.0
+        # touching it, the finger is nowhere inside it (what a grazing check asks)
+        assert -1e-9 < planar.depth(state, "bird") <= 1e-9
+    # and so with the belt out of reach, in the bird's mode alone
+    pressing = (np.array([0.1, radius - 2e-3]), disc[1])
+    sol, state = planar.solve(pressing, 0.0, Plane(NORMAL, belt_offset(-0.05)), planar_law(MU))
+    assert sol.converged and state.mode == "interior", sol.message
+    assert -1e-9 < planar.depth(state, "bird") <= 1e-9

@@ -234,14 +234,19 @@ class PlanarBeltContact(BeltedContact):
 
     def _bird_depth(self, state: Belted) -> float:
         """How deep the finger (not touching the bird) is inside it (m; ≤ 0 outside)."""
-        level = _overlap(state.bird, self.length) if state.mode == "free" else \
-            self._deepest(state).level
+        if state.mode == "free":
+            level = _overlap(state.bird, self.length)
+        elif state.mode == "belt":
+            level = self._deepest(state).level
+        else:                                   # touching the bird, grazing it
+            level = float(np.min(_level(state.bird, self._points(state))))
         B = _matrix(state.bird)
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(B).max()))
 
     def _touch(self, state: Belted) -> tuple[float, int, float] | None:
-        """Where the finger enters the bird most deeply: arc length (m), the
-        side it is bent to, and the force direction α of a first touch there."""
+        """Where the finger (free or on the belt) enters the bird most deeply:
+        arc length (m), the side it is bent to, and the force direction α of
+        a first touch there."""
         tau_mu = float(state.friction[0])
         if state.mode == "free":
             side = state.side or self._entering_side(state.bird)

@@ -17,7 +17,7 @@ from design.physics.rod import quaternion_rotation
 from design.solvers.beam.collocation import legendre_tables
 from design.solvers.beam.rod import N_STATE
 from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belted,
-                                                    BeltedContact, Plane, deepest)
+                                                    BeltedContact, Deepest, Plane, deepest)
 from design.solvers.contact.robust import BASE_FRACTION
 from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, SpatialState, grazing_shift,
@@ -202,27 +202,25 @@ class SpatialBeltContact(BeltedContact):
         if state.mode == "free":
             level = segment_level(quadric, self.length)
         elif state.mode == "belt":
-            level = deepest(self._points(state), self._tangents(state), quadric.center,
-                            quadric.matrix).level
-        else:
+            level = self._deepest(state, quadric).level
+        else:                                   # touching the bird, grazing it
             level = float(np.min(quadric.level(self._points(state))))
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
 
+    def _deepest(self, state: Belted, quadric: Quadric) -> Deepest:
+        """Where a ``belt`` state's finger goes deepest into the bird."""
+        return deepest(self._points(state), self._tangents(state), quadric.center,
+                       quadric.matrix)
+
     def _grazing(self, state: Belted) -> float | None:
-        """Arc length (m) where the finger enters the bird most deeply."""
+        """Arc length (m) where the finger (free or on the belt) enters the
+        bird most deeply."""
         quadric = Quadric.from_params(state.bird)
         if state.mode == "free":
             graze = grazing_shift(quadric, self.length)
             return None if graze is None else graze[1]
-        if state.mode == "belt":
-            arc = self.length * deepest(self._points(state), self._tangents(state),
-                                        quadric.center, quadric.matrix).fraction
-            return arc if arc > BASE_FRACTION * self.length else None
-        pts = self._points(state)
-        arcs = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=1), axis=0))])
-        arcs *= self.length / arcs[-1]
-        k = int(np.argmin(quadric.level(pts)))
-        return float(arcs[k]) if arcs[k] > BASE_FRACTION * self.length else None
+        arc = self.length * self._deepest(state, quadric).fraction
+        return arc if arc > BASE_FRACTION * self.length else None
 
     def _straight(self) -> np.ndarray:
         return self.contact.tr["interior"].rod.straight()
