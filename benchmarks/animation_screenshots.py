@@ -3,8 +3,8 @@ step the animation to three instants and screenshot each; measure how many
 frames a second it plays at 1x.
 
     apt-get install chromium            # once
-    python benchmarks/animation_screenshots.py reports/hold_time/report.html \\
-        [--times 0.1 0.3 0.6] [--out docs/img]
+    python -m benchmarks.animation_screenshots reports/hold_time/report.html \\
+        [--times 0.6 1.0 1.2] [--out docs/img]
 
 Prints the report's size, the load time (navigation to the figure drawn,
 the median of three loads), the frame rate, and writes
@@ -30,7 +30,7 @@ PLAY_S = 3.0
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("report", type=Path)
-    parser.add_argument("--times", type=float, nargs=3, default=(0.1, 0.3, 0.6))
+    parser.add_argument("--times", type=float, nargs=3, default=(0.6, 1.0, 1.2))
     parser.add_argument("--out", type=Path, default=Path("docs/img"))
     args = parser.parse_args()
     from playwright.sync_api import sync_playwright
