@@ -10,7 +10,7 @@ design variables (scaled to their boxes) and verified hold are compared
 with the first run's: they should agree within 1e-3 and 1 ms. Prints a table
 and writes benchmarks/results/reproducible.json.
 
-    python -m benchmarks.reproducible [PROBLEM] [--workers 2] [--keep DIR]
+    python -m benchmarks.reproducible [PROBLEM] [--workers 2] [--keep DIR] [--only LABEL ...]
 """
 
 from __future__ import annotations
@@ -91,13 +91,17 @@ def main() -> None:
     parser.add_argument("problem", nargs="?", default=str(ROOT / "problems" / "hold_time.yaml"))
     parser.add_argument("--workers", type=int, default=1)
     parser.add_argument("--keep", type=Path, help="keep every run's output folder here")
+    parser.add_argument("--only", nargs="+", choices=[v[0] for v in VARIATIONS[1:]],
+                        help="run these variations (and the reference) only")
     args = parser.parse_args()
     problem = Path(args.problem).resolve()
+    chosen = [v for v in VARIATIONS if v is VARIATIONS[0] or args.only is None or
+              v[0] in args.only]
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp) if args.keep is None else args.keep.resolve()
         folder.mkdir(parents=True, exist_ok=True)
         jobs = [(perturbed(problem, folder) if perturb else problem, label, changes)
-                for label, changes, perturb in VARIATIONS]
+                for label, changes, perturb in chosen]
         with ThreadPoolExecutor(args.workers) as pool:
             runs = list(pool.map(lambda job: run(*job, folder), jobs))
     reference = runs[0]
@@ -126,6 +130,8 @@ def main() -> None:
         str(problem), "tolerances": {"design_scaled": DESIGN_TOLERANCE,
                                      "hold_s": HOLD_TOLERANCE},
         "rows": rows, "runs": runs, "date": time.strftime("%Y-%m-%d"),
+        "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                                 capture_output=True, text=True).stdout.strip(),
         "machine": {"cpus": os.cpu_count()}})
 
 
