@@ -25,7 +25,6 @@ import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-import numpy as np
 import yaml
 
 from benchmarks.results_file import write_results
@@ -61,7 +60,7 @@ def perturbed(problem: Path, folder: Path) -> Path:
     scene["mounts"] = {"4": {"angle": f"{degrees * (1 + 1e-9)!r} deg"}}
     data["scene"] = scene
     out = folder / problem.name
-    out.write_text(yaml.safe_dump(data))
+    out.write_text(yaml.safe_dump(data, sort_keys=False))  # the variables' order kept
     return out
 
 
@@ -81,9 +80,18 @@ def run(problem: Path, label: str, changes: dict, folder: Path) -> dict:
             "numerics": result.get("numerics"), "stderr": done.stderr[-2000:]}
 
 
-def scaled(variables: list[dict]) -> np.ndarray:
-    return np.array([(v["optimum"] - v["lower"]) / (v["upper"] - v["lower"])
-                     for v in variables])
+def scaled(variables: list[dict]) -> dict[str, float]:
+    """Each variable's optimum scaled to its box, by name."""
+    return {v["name"]: (v["optimum"] - v["lower"]) / (v["upper"] - v["lower"])
+            for v in variables}
+
+
+def difference(variables: list[dict], reference: list[dict]) -> float:
+    """The largest scaled difference of two designs, variable by variable."""
+    a, b = scaled(variables), scaled(reference)
+    if a.keys() != b.keys():
+        raise ValueError(f"the runs design different variables: {sorted(a)} and {sorted(b)}")
+    return max(abs(a[name] - b[name]) for name in a)
 
 
 def main() -> None:
@@ -108,8 +116,7 @@ def main() -> None:
     rows = []
     for r in runs:
         ok = r["exit"] in (0, 1) and r["variables"] and reference["variables"]
-        design = float(np.max(np.abs(scaled(r["variables"]) - scaled(reference["variables"])))) \
-            if ok else None
+        design = difference(r["variables"], reference["variables"]) if ok else None
         hold = abs(r["hold_time_s"] - reference["hold_time_s"]) if ok else None
         rows.append({"variation": r["label"], "status": r["status"],
                      "wall_time_s": round(r["wall_time_s"], 1),

@@ -23,7 +23,10 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # design/solvers/optimize/robustness.py); default false
     solver: {time_step: 0.005, beam_intervals: 6, max_iter: 40, outer_iterations: 6,
              trust_region: 0.15, cap_margin: 0.25, ipopt: {}}   # beam_intervals: the
-                               # finger mesh, by default the scene's contact_nodes
+                               # finger mesh, by default the scene's contact_nodes;
+                               # method: trust-region (default: Ipopt moves the design)
+                               # or pattern (the simulator's lattice search, the same
+                               # answer under round-off: pattern_search.py)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
@@ -43,7 +46,7 @@ from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
 from design.solvers.optimize.finger_load import STAGE_MODELS
 from design.solvers.optimize.model_check import CHECK_MODEL
-from design.solvers.optimize.policy import SOLVER_KEYS, loop_settings
+from design.solvers.optimize.policy import LOOP_METHODS, SOLVER_KEYS, loop_settings
 from design.solvers.optimize.population import AGGREGATES
 from design.solvers.optimize.transcription import Rules
 from design.solvers.optimize.trust_region import LoopSettings
@@ -347,6 +350,8 @@ def _solver(reader: Reader, value: object) -> dict | None:
                                         lo_open=lo_open)
                    for key, (dimension, lo, hi, lo_open) in SOLVER_QUANTITIES.items()
                    if key in spec})
+    if "method" in spec:
+        stated["method"] = reader.choice(spec, "method", "solver", LOOP_METHODS)
     if "ipopt" in spec:
         if not isinstance(spec["ipopt"], Mapping):
             reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")

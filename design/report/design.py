@@ -117,6 +117,24 @@ def population_section(page: Page, population: dict) -> None:
                "population-table")
 
 
+def search_table(page: Page, solver: dict) -> None:
+    """The pattern search's simulations, in order: the step (scaled), the
+    variable moved, the simulated hold and peak, and whether it was taken."""
+    s = solver["search"]
+    page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
+              f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
+              f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
+              f"with every finger under the cap; {s['simulations']} simulations of at most "
+              f"{s['max_simulations']}" + ("" if s["lattice_optimum"] else
+                                           ", the budget ending the search") + ".")
+    page.table([{"simulation": h["iteration"], "step (scaled)": h["radius"],
+                 "variable": h["variable"], "move": h["move"],
+                 "simulated hold (s)": h["simulated_hold_time_s"],
+                 "simulated peak (N)": h["simulated_peak_force_N"],
+                 "taken": h["accepted"]} for h in solver["history"]],
+               "Pattern search", "history-table")
+
+
 def multistart_section(page: Page, multistart: dict) -> None:
     """The starts and the distinct optima they reached."""
     page.section("Starts and local optima", "multistart")
@@ -258,14 +276,18 @@ def design_page(result: dict, baseline: GraspRun, optimum: GraspRun) -> Page:
         robustness_section(page, result["robustness"])
     page.section("Optimiser convergence", "convergence")
     history = result["solver"]["history"]
-    page.table([{"outer iteration": h["iteration"], "trust region": h["radius"],
-                 "NLP cap (N)": h.get("nlp_cap_N"), "Ipopt status": h.get("ipopt_status", "error"),
-                 "Ipopt iterations": h.get("ipopt_iterations"),
-                 "NLP hold (s)": h.get("nlp_hold_time_s"),
-                 "simulated hold (s)": h.get("simulated_hold_time_s"),
-                 "simulated peak (N)": h.get("simulated_peak_force_N"),
-                 "accepted": h.get("accepted", False)} for h in history],
-               "Trust-region iterations", "history-table")
+    if result["solver"].get("method") == "pattern":
+        search_table(page, result["solver"])
+    else:
+        page.table([{"outer iteration": h["iteration"], "trust region": h["radius"],
+                     "NLP cap (N)": h.get("nlp_cap_N"),
+                     "Ipopt status": h.get("ipopt_status", "error"),
+                     "Ipopt iterations": h.get("ipopt_iterations"),
+                     "NLP hold (s)": h.get("nlp_hold_time_s"),
+                     "simulated hold (s)": h.get("simulated_hold_time_s"),
+                     "simulated peak (N)": h.get("simulated_peak_force_N"),
+                     "accepted": h.get("accepted", False)} for h in history],
+                   "Trust-region iterations", "history-table")
     if any(h.get("history") for h in history):
         page.figure(convergence_figure(history), "convergence",
                     "Ipopt convergence: the NLP's hold time and its constraint violation")

@@ -42,6 +42,7 @@ from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
 from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
+from design.solvers.optimize.pattern_search import search
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.transcription import rule_margins
 from design.solvers.optimize.trust_region import (CAP_TOLERANCE, Outcome, Scored, caps_text,
@@ -288,8 +289,9 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     first = upstream is None and case.inputs["start_index"] == 0
     say(f"cap {k + 1} of {len(problem.caps)}: {caps_text(caps)} "
         f"({problem.caps[k].describe()})")
-    outcome = optimise(population, caps, settings, problem.rules, None if first else start,
-                       progress, anchor=upstream is not None)
+    outcome = design_loop(settings)(population, caps, settings, problem.rules,
+                                    None if first else start, progress,
+                                    anchor=upstream is not None)
     certify(population, outcome, settings, problem.rules, progress)
     if check and k == 0 and problem.model_check != "none":
         check.submit(case.key, population, outcome.best.d)
@@ -316,13 +318,18 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
     settings = problem.settings
     own = Population.of(space)
     cap = case.inputs["cap_N"]
-    outcome = optimise(own, cap, settings, problem.rules)
+    outcome = design_loop(settings)(own, cap, settings, problem.rules)
     fine = verify(population, outcome.best.d, settings)
     if kept is not None:
         kept.profiles[case.key] = outcome.profile
     return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
             "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
             "peaks_N": fine.peaks.tolist(), "hold_time_s": fine.hold}
+
+
+def design_loop(settings):
+    """The loop the problem names (``solver: {method: ..}``)."""
+    return search if settings.method == "pattern" else optimise
 
 
 def _rank(result: dict) -> tuple:
@@ -522,6 +529,7 @@ def _entry(space: DesignSpace, problem: DesignProblem, outcome: Outcome, fine: S
                                                              space.baseline, problem.rules)
                          if margin < -1e-9],
         "solver": {
+            "method": problem.settings.method, "search": outcome.search,
             "ipopt_status": outcome.nlp.status if outcome.nlp else
             (iterations[-1].get("ipopt_status", "not run") if iterations else "not run"),
             "iterations": int(sum(i.get("ipopt_iterations", 0) for i in iterations)),

@@ -18,8 +18,12 @@ from design.solvers.optimize.transcription import NLPSettings
 from design.solvers.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
 
 #: a design problem's ``solver`` keys (SI values), each optional
-SOLVER_KEYS = ("time_step", "beam_intervals", "max_iter", "tolerance", "outer_iterations",
-               "trust_region", "cap_margin", "ipopt")
+SOLVER_KEYS = ("method", "time_step", "beam_intervals", "max_iter", "tolerance",
+               "outer_iterations", "trust_region", "cap_margin", "ipopt")
+#: the design loops a problem may name: Ipopt's trust-region loop
+#: (design/solvers/optimize/trust_region.py) or the pattern search on the
+#: simulator (design/solvers/optimize/pattern_search.py)
+LOOP_METHODS = ("trust-region", "pattern")
 
 
 def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
@@ -46,4 +50,5 @@ def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
                         max_step=min(given.max_step, nlp.time_step))
     return LoopSettings(nlp, solver.get("outer_iterations", d.outer_iterations),
                         solver.get("trust_region", d.radius), d.min_radius, simulator, mesh,
-                        solver.get("cap_margin", d.cap_margin))
+                        solver.get("cap_margin", d.cap_margin),
+                        solver.get("method", d.method))

@@ -85,6 +85,9 @@ class LoopSettings:
     #: the NLP's cap starts this fraction below the true cap and the margin
     #: halves at every outer iteration (continuation; see :func:`optimise`)
     cap_margin: float = 0.25
+    #: "trust-region" (this module's loop) or "pattern" (design/solvers/
+    #: optimize/pattern_search.py: the same answer under round-off)
+    method: str = "trust-region"
 
 
 @dataclass
@@ -181,6 +184,8 @@ class Outcome:
     wall_time: float = 0.0
     #: where the loop's time went (its simulations, NLPs and views)
     profile: Profile = field(default_factory=Profile)
+    #: a pattern search's settings and count (None: the trust-region loop)
+    search: dict | None = None
 
     @property
     def cap(self) -> float:
@@ -225,17 +230,19 @@ def score(population: Population, d: np.ndarray, settings: LoopSettings,
                                          for m in population.members], population)
 
 
-def better(a: Scored, b: Scored, caps) -> bool:
+def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
+           band: float = 1e-5) -> bool:
     """Is a better than b: feasible (every bird under its cap, every finger
-    under its fold force, no jam; within the verification's CAP_TOLERANCE,
-    so that a baseline whose own peak is the cap is not judged by its
-    rounding) beats infeasible, then the longer hold by more than 10 µs;
-    among infeasible designs the smaller largest excess over a limit."""
-    fa, fb = a.within(caps, CAP_TOLERANCE), b.within(caps, CAP_TOLERANCE)
+    under its fold force, no jam; within ``tolerance``, by default the
+    verification's, so that a baseline whose own peak is the cap is not
+    judged by its rounding) beats infeasible, then the longer hold by more
+    than ``band`` (s); among infeasible designs the smaller largest excess
+    over a limit, by more than 1 mN."""
+    fa, fb = a.within(caps, tolerance), b.within(caps, tolerance)
     if fa != fb:
         return fa
     if fa:
-        return a.hold > b.hold + 1e-5
+        return a.hold > b.hold + band
     return a.excess(caps) < b.excess(caps) - 1e-3
 
 
