@@ -13,27 +13,37 @@ comparison of two simulated holds or of a peak with the cap flips:
 * a coordinate search with a step of 8 lattice units (1/8 of each box),
   then 4, 2, 1: for each variable in the problem's order it simulates one
   step up and one down; the better of the two (up on a tie) is taken if it
-  beats the incumbent, and the search keeps stepping that way while each
-  step beats it; a sweep that moves nothing halves the step;
+  beats the incumbent, and the search keeps going that way, each step twice
+  the last (at most 8 units), two steps simulated together, while each
+  beats the last; a sweep that moves nothing halves the step;
 * "beats" is :func:`~trust_region.better` with a band: a longer hold by more
-  than :data:`HOLD_BAND` (0.1 ms, ten times the search simulator's error
-  on the hold), every finger under the cap (no tolerance: the verification
-  allows 1 % for its finer resolution) and under its fold force, no jam;
-* the search's simulations are the scene's integrator with rtol 1e-4 and
-  steps no longer than the optimiser's grid: the decisions need holds to
-  0.1 ms, not the trust-region loop's 1e-6 (whose views must reproduce
-  them), and it halves the cost of a simulation;
-* a budget of simulations ends the search, as deterministically.
+  than :data:`HOLD_BAND` (0.1 ms: a smaller gain is not worth a move, and
+  the band keeps two near-equal holds from being ordered by round-off),
+  every finger under the cap (no tolerance: the verification allows 1 %
+  for its finer resolution) and under its fold force, no jam;
+* the search's simulations are the loop's (rtol 1e-6, steps no longer than
+  the optimiser's grid): the cap is decided on the peak force, and a looser
+  tolerance can step over a force transient of a few ms at a contact;
+* a budget of simulations ends the search, as deterministically;
+* the two designs of a poll or an extension are simulated in two
+  processes where there are two cores: the same simulations as one process
+  would run, in half the wall time.
 
-The best design is simulated again with the loop's own simulator, so that
-its fixed-design NLP view (the optimiser's claim) and the 4x finer
-verification judge it exactly as they judge a trust-region design.
+The search's claim for its design is its own simulation of it; the
+verification simulates it again at 4x finer resolution (steps a quarter of
+the grid's, tolerances 256x tighter) and must agree within 2 % on the hold.
+The trust-region loop's claim, the collocation NLP with the design fixed,
+is not asked for: it can stall short of feasibility on a design two
+simulations agree on, and a claim that cannot be made would fail it.
 """
 
 from __future__ import annotations
 
+import copy
+import multiprocessing
+import os
 import time
-from dataclasses import replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -48,55 +58,139 @@ from design.solvers.optimize.variables import DesignSpace
 LATTICE, FIRST_STEP = 1 / 64, 8
 #: a move must lengthen the hold by more than this (s)
 HOLD_BAND = 1e-4
-#: the search simulator's relative tolerance
-SEARCH_RTOL = 1e-4
 #: the default budget of simulations
 MAX_SIMULATIONS = 150
 
 
-class Lattice:
-    """The points ``clip(d0 + LATTICE * k, 0, 1)`` and their simulations, by ``k``."""
+@dataclass
+class Trial:
+    """One evaluated lattice point: its scaled design, its value, and the
+    move that reached it (variable index, step in lattice units, ``poll`` or
+    ``extend``) and whether the search took it."""
 
-    def __init__(self, d0: np.ndarray, simulate):
-        self.d0 = np.asarray(d0, float)
-        self.lo = -np.ceil(self.d0 / LATTICE).astype(int)
-        self.hi = np.ceil((1 - self.d0) / LATTICE).astype(int)
-        self.simulate = simulate
-        self.seen: dict[tuple, Scored] = {}
+    d: np.ndarray
+    value: object
+    variable: int
+    units: int
+    move: str
+    taken: bool = False
 
-    def point(self, k: np.ndarray) -> np.ndarray:
-        return np.clip(self.d0 + LATTICE * k, 0.0, 1.0)
 
-    def step(self, k: np.ndarray, i: int, units: int) -> np.ndarray:
-        """``k`` moved ``units`` along variable ``i``, stopped at the box."""
-        moved = k.copy()
-        moved[i] = min(max(k[i] + units, self.lo[i]), self.hi[i])
-        return moved
+@dataclass
+class Searched:
+    """A search's answer: the best point and its value, every trial in
+    order, and whether no step of one lattice unit beats the answer."""
 
-    def __call__(self, k: np.ndarray) -> Scored:
-        key = tuple(int(x) for x in k)
-        if key not in self.seen:
-            self.seen[key] = self.simulate(self.point(k))
-        return self.seen[key]
+    d: np.ndarray
+    value: object
+    trials: list[Trial]
+    lattice_optimum: bool
+
+
+def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True,
+            max_evaluations: int = MAX_SIMULATIONS, moved=None) -> Searched:
+    """The coordinate search of the module's docstring on the lattice
+    ``clip(d0 + LATTICE * k, 0, 1)`` (scaled variables, integer ``k``).
+
+    ``evaluate_many(designs)`` gives the values of a list of designs (the
+    caller may evaluate them in parallel), ``value0`` is ``d0``'s;
+    ``beats(a, b)`` says whether value a is better than b; a design that is
+    not ``allowed`` is not tried; ``moved(trial, count)`` hears of every
+    step taken. Every decision is a ``beats`` of two values, so the path
+    depends on the values only through those decisions."""
+    d0 = np.asarray(d0, float)
+    lo, hi = -np.ceil(d0 / LATTICE).astype(int), np.ceil((1 - d0) / LATTICE).astype(int)
+    seen: dict[tuple, object] = {(0,) * len(d0): value0}
+    trials: list[Trial] = []
+
+    def point(k):
+        return np.clip(d0 + LATTICE * np.asarray(k), 0.0, 1.0)
+
+    def step(k, i, units):
+        moved_k = list(k)
+        moved_k[i] = min(max(k[i] + units, lo[i]), hi[i])
+        return tuple(moved_k)
+
+    def evaluate(tried: list[tuple], i: int, move: str) -> list:
+        """The values of ``tried``'s points ((k, units) pairs), the unseen ones
+        evaluated together, as many as the budget allows (None beyond it)."""
+        new = [k for k in dict.fromkeys(k for k, _ in tried) if k not in seen]
+        new = new[:max(0, max_evaluations - len(seen))]
+        if new:
+            for k, v in zip(new, evaluate_many([point(k) for k in new])):
+                seen[k] = v
+                trials.append(Trial(point(k), v, i, dict(tried)[k], move))
+        return [seen.get(k) for k, _ in tried]
+
+    def take(k):
+        trial = next(t for t in reversed(trials) if np.array_equal(t.d, point(k)))
+        trial.taken = True
+        if moved:
+            moved(trial, len(seen))
+
+    def valid(t, k) -> bool:
+        return t != k and allowed(point(t))
+
+    k, units = (0,) * len(d0), FIRST_STEP
+    while units >= 1 and len(seen) < max_evaluations:
+        any_move = False
+        for i in range(len(d0)):
+            tries = [(t, u) for u in (units, -units) if valid(t := step(k, i, u), k)]
+            values = evaluate(tries, i, "poll") if tries else []
+            if not values or values[0] is None:
+                continue
+            best = 0 if len(values) == 1 or values[1] is None or \
+                not beats(values[1], values[0]) else 1
+            if not beats(values[best], seen[k]):
+                continue
+            (k, ext), any_move = tries[best], True
+            take(k)
+            # keep going that way, each step twice the last (up to the first
+            # step), two at a time: the pair is evaluated together
+            while True:
+                e1 = min(2 * abs(ext), FIRST_STEP) * (1 if ext > 0 else -1)
+                e2 = min(2 * abs(e1), FIRST_STEP) * (1 if ext > 0 else -1)
+                a = step(k, i, e1)
+                if not valid(a, k):
+                    break
+                b = step(a, i, e2)
+                pair = [(a, e1)] + ([(b, e2)] if valid(b, a) else [])
+                va, *vb = evaluate(pair, i, "extend")
+                if va is None or not beats(va, seen[k]):
+                    break
+                k = a
+                take(k)
+                if not vb or vb[0] is None or not beats(vb[0], va):
+                    break
+                k, ext = b, e2
+                take(k)
+        if not any_move:
+            units //= 2
+    return Searched(point(k), seen[k], trials, units < 1)
 
 
 def search(space: DesignSpace | Population, cap, settings: LoopSettings,
            rules: Rules = Rules(), start=None, progress=None, anchor: bool = True,
-           max_simulations: int = MAX_SIMULATIONS) -> Outcome:
+           max_simulations: int = MAX_SIMULATIONS, workers: int | None = None) -> Outcome:
     """Maximise the (population's) hold under the cap (N; one per bird, or one
     for all) from ``start`` (scaled; the baseline by default; with ``anchor``
-    a start worse than the baseline gives way to it). A point that breaks a
-    design rule the baseline keeps is not tried."""
+    a start worse than the baseline gives way to it) by :func:`compass`. A
+    point that breaks a design rule the baseline keeps is not tried. The
+    points evaluated together are simulated by ``workers`` processes (by
+    default one per core, at most two: :class:`Pairs`); the answer does not
+    depend on how many."""
     t0 = time.perf_counter()
     profile = Profile()
     say = progress or (lambda message: None)
     population = population_of(space)
     caps = np.broadcast_to(np.asarray(cap, float), (len(population.members),)).copy()
-    searching = replace(settings.simulator, rtol=max(settings.simulator.rtol, SEARCH_RTOL))
+    searching = settings.simulator
 
-    def simulate(d):
+    pool = Pairs(population, settings, searching, workers)
+
+    def simulate_all(designs):
         with profile.phase(SIMULATIONS):
-            return score(population, d, settings, searching)
+            return pool.score(designs)
 
     def beats(a: Scored, b: Scored) -> bool:
         return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
@@ -104,78 +198,110 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     d0 = population.space.scale(population.space.base_values)
     kept_at_start = keeps(population.space, d0, rules)
 
-    def allowed(lattice: Lattice, k: np.ndarray) -> bool:
+    def allowed(d) -> bool:
         return all(kept or not before for kept, before in
-                   zip(keeps(population.space, lattice.point(k), rules), kept_at_start))
-    base = Lattice(d0, simulate)
-    k0 = np.zeros(len(d0), int)
-    baseline = base(k0)
+                   zip(keeps(population.space, d, rules), kept_at_start))
+
+    baseline, = simulate_all([d0])
     failed = [f"{m.name}: {e.run.summary['message']}" for m, e in
               zip(population.members, baseline.members) if not e.run.summary["ok"]]
     if failed:
         raise ValueError("the baseline's simulation ended early, so no design can start from "
                          "it: " + "; ".join(failed))
-    lattice = base
+    origin, first = d0, baseline
     if start is not None:
-        started = Lattice(start, simulate)
-        if not (anchor and beats(baseline, started(k0))):
-            lattice = started
+        started, = simulate_all([np.asarray(start, float)])
+        if not (anchor and beats(baseline, started)):
+            origin, first = started.d, started
     names = [v.name for v in population.space.variables]
-    out = Outcome(baseline, baseline, caps, profile=profile)
-    k, step = k0, FIRST_STEP
     say(f"baseline: hold {baseline.hold:.4f} s, peak finger force {baseline.peak:.2f} N "
-        f"(cap {caps_text(caps)}); pattern search, steps of 1/{round(1 / (LATTICE * step))} "
-        f"to 1/{round(1 / LATTICE)} of each box")
+        f"(cap {caps_text(caps)}); pattern search, steps of {FIRST_STEP * LATTICE:g} to "
+        f"{LATTICE:g} of each box")
 
-    def record(kind: str, i: int, units: int, tried: Scored, taken: bool):
-        out.iterations.append({
-            "iteration": len(out.iterations) + 1, "radius": units * LATTICE, "move": kind,
-            "variable": names[i], "candidate_scaled": tried.d.tolist(),
-            "simulated_hold_time_s": tried.hold, "simulated_peak_force_N": tried.peak,
-            "accepted": taken, **({} if len(caps) == 1 else {
-                "simulated_hold_times_s": tried.holds.tolist(),
-                "simulated_peak_forces_N": tried.peaks.tolist()})})
+    def moved(trial: Trial, count: int):
+        say(f"step {abs(trial.units) * LATTICE:g}: {names[trial.variable]} "
+            f"{'up' if trial.units > 0 else 'down'} -> hold {trial.value.hold:.4f} s, peak "
+            f"{trial.value.peak:.2f} N ({count} simulations)")
 
-    def budget_left() -> bool:
-        return len(lattice.seen) < max_simulations
-
-    while step >= 1 and budget_left():
-        moved = False
-        for i in range(len(k)):
-            tries = [(units, lattice.step(k, i, units)) for units in (step, -step)]
-            tries = [(units, t) for units, t in tries
-                     if not np.array_equal(t, k) and allowed(lattice, t)]
-            if not tries or not budget_left():
-                continue
-            scored = [(units, t, lattice(t)) for units, t in tries]
-            units, t, s = scored[0]
-            if len(scored) == 2 and beats(scored[1][2], s):
-                units, t, s = scored[1]
-            for u, _, tried in scored:
-                record("poll", i, u, tried, tried is s and beats(s, lattice(k)))
-            while beats(s, lattice(k)):
-                k, moved = t, True
-                say(f"step 1/{round(1 / (LATTICE * step))}: {names[i]} "
-                    f"{'up' if units > 0 else 'down'} -> hold {s.hold:.4f} s, peak "
-                    f"{s.peak:.2f} N ({len(lattice.seen)} simulations)")
-                t = lattice.step(k, i, units)
-                if np.array_equal(t, k) or not allowed(lattice, t) or not budget_left():
-                    break
-                s = lattice(t)
-                record("extend", i, units, s, beats(s, lattice(k)))
-        if not moved:
-            step //= 2
-    with profile.phase(SIMULATIONS):
-        final = score(population, lattice(k).d, settings)
-    out.best = final
-    if lattice is base and not k.any():
-        out.baseline = final      # nothing beat the baseline: the answer is the baseline
+    with pool:
+        found = compass(simulate_all, origin, first, beats, allowed, max_simulations, moved)
+    out = Outcome(found.value, baseline, caps, profile=profile)
+    source = f"the pattern search's simulation (rtol {searching.rtol:g}, steps up to the grid's)"
+    out.claims = [(m.hold, source) for m in found.value.members]
+    out.claim = found.value.hold, source
+    out.iterations = [{
+        "iteration": n + 1, "radius": abs(t.units) * LATTICE, "move": t.move,
+        "variable": names[t.variable], "direction": int(np.sign(t.units)),
+        "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
+        "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
+        **({} if len(caps) == 1 else {"simulated_hold_times_s": t.value.holds.tolist(),
+                                      "simulated_peak_forces_N": t.value.peaks.tolist()})}
+        for n, t in enumerate(found.trials)]
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
                   "hold_band_s": HOLD_BAND, "rtol": searching.rtol,
-                  "simulations": len(lattice.seen), "max_simulations": max_simulations,
-                  "lattice_optimum": step < 1, "caps_N": caps_value(caps)}
+                  "simulations": len(found.trials) + 1 + (start is not None),
+                  "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
+                  "processes": pool.processes,
+                  "caps_N": caps_value(caps)}
     out.wall_time = time.perf_counter() - t0
     return out
+
+
+#: the population, loop settings and integrator of a :class:`Pairs` pool's
+#: forked processes (set before they fork; the parent's only otherwise)
+_SCORING: tuple | None = None
+
+
+def _score_slim(d: np.ndarray) -> Scored:
+    population, settings, integrator = _SCORING
+    return slim(score(population, d, settings, integrator))
+
+
+def slim(scored: Scored) -> Scored:
+    """The scored design without its trajectories (tens of MB each): what a
+    search decides by (each run's setup and summary) passes between processes."""
+    for member in scored.members:
+        summary = member.run.summary
+        member.run = copy.copy(member.run)
+        member.run.trajectory, member.run.windows = None, None
+        member.run.__dict__["summary"] = summary
+    return scored
+
+
+class Pairs:
+    """Simulates the designs a search evaluates together (a poll's two, an
+    extension's two) in forked processes, or here where there is one core,
+    no ``fork``, or this process is a daemon (a Dask worker's) that may not
+    have children. A forked child computes exactly what this process would."""
+
+    def __init__(self, population: Population, settings: LoopSettings, integrator,
+                 workers: int | None):
+        self.job = (population, settings, integrator)
+        wanted = min(2, os.cpu_count() or 1) if workers is None else workers
+        usable = "fork" in multiprocessing.get_all_start_methods() and \
+            not multiprocessing.current_process().daemon
+        self.processes = wanted if wanted > 1 and usable else 1
+        self.pool = None
+
+    def __enter__(self) -> Pairs:
+        global _SCORING
+        if self.processes > 1:
+            _SCORING = self.job
+            self.pool = multiprocessing.get_context("fork").Pool(self.processes)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        global _SCORING
+        if self.pool is not None:
+            self.pool.terminate()
+            self.pool.join()
+            self.pool, _SCORING = None, None
+
+    def score(self, designs: list) -> list[Scored]:
+        if self.pool is None or len(designs) == 1:
+            population, settings, integrator = self.job
+            return [slim(score(population, d, settings, integrator)) for d in designs]
+        return self.pool.map(_score_slim, designs, chunksize=1)
 
 
 def keeps(space: DesignSpace, d: np.ndarray, rules: Rules) -> list[bool]:

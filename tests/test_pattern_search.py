@@ -1,0 +1,94 @@
+"""The pattern search's lattice coordinate search (design/solvers/optimize/
+pattern_search.py) on analytic objectives: it finds the lattice optimum,
+keeps its budget and the allowed region, and its path does not move when
+the objective and the start move by round-off."""
+
+import numpy as np
+import pytest
+
+from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, compass
+
+CENTRE = np.array([0.71, 0.23, 0.5, 0.9])
+WEIGHT = np.array([1.0, 3.0, 0.5, 2.0])
+
+
+def quadratic(d, noise: float = 0.0):
+    """A concave objective, maximal at CENTRE, with a relative error of
+    ``noise`` that depends on d's bits (round-off of another machine)."""
+    value = -float(np.sum(WEIGHT * (np.asarray(d) - CENTRE) ** 2))
+    jitter = np.sin(1e4 * np.dot(d, [1.0, 2.0, 3.0, 4.0]))
+    return value * (1 + noise * jitter)
+
+
+def run(d0, noise=0.0, band=1e-6, **kw):
+    def evaluate_many(designs):
+        return [quadratic(d, noise) for d in designs]
+    return compass(evaluate_many, np.asarray(d0, float), quadratic(d0, noise),
+                   lambda a, b: a > b + band, **kw)
+
+
+def test_the_search_ends_at_the_lattice_optimum():
+    """Every coordinate of the answer is within half a lattice unit of the
+    centre (the objective is separable, so the best lattice point rounds each
+    coordinate), and no neighbour one unit away is better."""
+    d0 = np.full(4, 0.5)
+    found = run(d0)
+    assert found.lattice_optimum
+    assert np.all(np.abs(found.d - CENTRE) <= LATTICE / 2 + 1e-12)
+    for i in range(4):
+        for s in (1, -1):
+            neighbour = np.clip(found.d + s * LATTICE * np.eye(4)[i], 0, 1)
+            assert quadratic(neighbour) <= found.value + 1e-12
+
+
+def test_round_off_does_not_move_the_path(monkeypatch):
+    """A start moved by 1e-9 (relative) and objective values wrong by up to
+    1e-9 (relative): the same moves, the same answer to 1e-9. The first
+    coordinate's optimum lies half-way between two lattice points, which
+    tie: without the band the round-off picks one of them, with it neither
+    displaces the other."""
+    monkeypatch.setattr("tests.test_pattern_search.CENTRE",
+                        np.array([0.5 + 3.5 * LATTICE, 0.23, 0.5, 0.9]))
+    d0 = np.array([0.5, 0.5, 0.5, 0.3])
+
+    def moves(found):
+        return [(t.variable, t.units, t.move, t.taken) for t in found.trials]
+    for band, same in ((1e-6, True), (0.0, False)):
+        a = run(d0, band=band)
+        b = run(d0 * (1 + 1e-9), noise=1e-9, band=band)
+        assert (moves(a) == moves(b)) == same
+        assert (np.max(np.abs(a.d - b.d)) < 1e-8) == same
+
+
+def test_the_band_refuses_a_gain_smaller_than_itself():
+    """With a band wider than any one-unit gain near the optimum the search
+    stops on a coarser point; the band only ever refuses moves."""
+    d0 = np.full(4, 0.5)
+    fine, coarse = run(d0), run(d0, band=1e-3)
+    assert coarse.value <= fine.value
+    assert not np.allclose(coarse.d, fine.d)
+    steps = [t for t in coarse.trials if t.taken]
+    values = [quadratic(d0)] + [t.value for t in steps]
+    assert all(later > earlier + 1e-3 for earlier, later in zip(values, values[1:]))
+
+
+def test_the_budget_and_the_allowed_region_are_kept():
+    """Never more evaluations than the budget (the start counts), never a
+    point outside the allowed region, and the answer inside it."""
+    d0 = np.full(4, 0.5)
+    small = run(d0, max_evaluations=5)
+    assert len(small.trials) + 1 <= 5 and not small.lattice_optimum
+
+    def allowed(d):
+        return d[0] + d[3] <= 1.2
+    kept = run(d0, allowed=allowed)
+    assert all(allowed(t.d) for t in kept.trials) and allowed(kept.d)
+    assert kept.d[0] + kept.d[3] == pytest.approx(1.2, abs=2 * LATTICE)
+
+
+def test_steps_halve_from_an_eighth_to_one_lattice_unit_and_stop_at_the_box():
+    d0 = np.array([0.95, 0.5, 0.5, 0.5])
+    found = run(d0)
+    steps = sorted({abs(t.units) for t in found.trials}, reverse=True)
+    assert steps == [FIRST_STEP >> n for n in range(len(steps))] and steps[-1] == 1
+    assert np.all((found.d >= 0) & (found.d <= 1))
