@@ -10,6 +10,8 @@ import yaml
 import design
 from design.cli import main
 from design.io.design_problem import DesignProblem
+from design.run.solve import design_loop
+from design.solvers.optimize.pattern_search import search
 
 ROOT = Path(__file__).resolve().parents[1]
 PROBLEM = yaml.safe_load((ROOT / "problems" / "hold_time.yaml").read_text())
@@ -55,6 +57,8 @@ def test_units_and_caps_are_read_in_si():
     ({"variables": {"groups.lower.stiffness_scale": [0, 2]}},
      "variables.groups.lower.stiffness_scale", "must be > 0"),
     ({"solver": {"time_step": 2}}, "solver.time_step", "outside the accepted range"),
+    ({"solver": {"method": "simplex"}}, "solver.method",
+     "'simplex' is not one of: trust-region, pattern"),
     ({"scene": "no_such_scene.yaml"}, "scene", "cannot find"),
     # a spatial scene has no other model to check against
     ({"scene": str(ROOT / "problems" / "grasp_football.yaml"), "model_check": "spatial"},
@@ -140,3 +144,5 @@ def test_a_problem_built_in_python_runs_with_its_files_settings():
     assert loop.nlp.beam_intervals == loop.contact_nodes == scene.contact_nodes
     assert loop.simulator.max_step == loop.nlp.time_step == data["solver"]["time_step"]
     assert loop.simulator.rtol < scene.integrator.rtol
+    assert loop.method == data["solver"]["method"] == "pattern"
+    assert design_loop(loop) is search
