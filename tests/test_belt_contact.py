@@ -15,6 +15,7 @@ friction (ε = 0.02 m/s) is µN within 0.3 %.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from functools import lru_cache
 
 import numpy as np
@@ -25,7 +26,8 @@ from design.physics.beam import Finger
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
 from design.solvers.contact import RobustContact
-from design.solvers.contact.belt_continuation import Belted, Plane, deepest
+from design.solvers.contact.belt_continuation import (GRAZE_DEPTH, BeltedContact, Belted,
+                                                      Plane, deepest)
 from design.solvers.contact.planar_belt import PlanarBeltContact
 from design.solvers.contact.spatial import FrictionLaw, Quadric, SpatialContact
 from design.solvers.contact.spatial_belt import SpatialBeltContact
@@ -270,8 +272,8 @@ def test_a_bird_between_the_finger_s_nodes_is_touched():
     chord = (pts[:, k + 1] - pts[:, k]) / gaps[k]
     radius = 0.05
     dip = 0.5 * (gaps[k] / 2) ** 2 / (2 * radius)
-    ball = Quadric(0.5 * (pts[:, k] + pts[:, k + 1]) + (radius - dip) * np.cross([0, 0, 1.0], chord),
-                   np.eye(3) / radius ** 2)
+    centre = 0.5 * (pts[:, k] + pts[:, k + 1]) + (radius - dip) * np.cross([0, 0, 1.0], chord)
+    ball = Quadric(centre, np.eye(3) / radius ** 2)
     assert ball.level(pts).min() > 0.0
     for previous in (resting, None):
         sol, state = spatial.solve(ball, FrictionLaw(), plane, spatial_law(MU), previous)
@@ -354,3 +356,40 @@ def test_the_planar_finger_on_the_belt_touches_a_bird_between_its_nodes():
     sol, state = planar.solve(pressing, 0.0, Plane(NORMAL, belt_offset(-0.05)), planar_law(MU))
     assert sol.converged and state.mode == "interior", sol.message
     assert -1e-9 < planar.depth(state, "bird") <= 1e-9
+
+
+class _Scripted(BeltedContact):
+    """A continuation whose Newton solves return their start and whose events
+    follow a script: the bird touched, then the touch pulling on the bird."""
+
+    def __init__(self, events):
+        super().__init__()
+        self.events = list(events)
+
+    def _newton(self, state):
+        return state
+
+    def depth(self, state, kind):
+        return 0.0
+
+    def event(self, state):
+        return self.events.pop(0) if self.events else None
+
+    def switch(self, state, kind):
+        return replace(state, mode=kind)
+
+
+def test_a_first_touch_that_pulls_grazes_and_one_that_pulls_again_fails_the_step():
+    """A finger reaching the bird switches into contact; if that contact would
+    pull (its force negative), the step ends at the touch, the finger still
+    free and grazing: it may enter the bird by GRAZE_DEPTH before a contact
+    is tried again. A finger
+    already grazing whose touch pulls again has no contact to follow: the
+    step fails (None) and is shortened, rather than grazing deeper."""
+    free = Belted("free", None, np.zeros(3), np.zeros(2), Plane(np.array([0.0, 1.0]), 0.0),
+                  np.zeros(2))
+    script = [("bird", 0.0), ("release-bird", 0.0)]
+    grazed = _Scripted(script)._step(free, free, 1.0)
+    assert grazed.mode == "free" and grazed.graze == GRAZE_DEPTH
+    again = replace(free, graze=GRAZE_DEPTH)
+    assert _Scripted(script)._step(again, again, 1.0) is None
