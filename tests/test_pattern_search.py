@@ -3,10 +3,13 @@ pattern_search.py) on analytic objectives: it finds the lattice optimum,
 keeps its budget and the allowed region, and its path does not move when
 the objective and the start move by round-off."""
 
+import os
+
 import numpy as np
 import pytest
 
-from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, compass
+from design.solvers.optimize import pattern_search
+from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
 
 CENTRE = np.array([0.71, 0.23, 0.5, 0.9])
 WEIGHT = np.array([1.0, 3.0, 0.5, 2.0])
@@ -92,3 +95,24 @@ def test_steps_halve_from_an_eighth_to_one_lattice_unit_and_stop_at_the_box():
     steps = sorted({abs(t.units) for t in found.trials}, reverse=True)
     assert steps == [FIRST_STEP >> n for n in range(len(steps))] and steps[-1] == 1
     assert np.all((found.d >= 0) & (found.d <= 1))
+
+
+class _Value:
+    """A stand-in for a scored design: its value and the process that made it."""
+
+    members: list = []
+
+    def __init__(self, d):
+        self.value, self.pid = quadratic(d), os.getpid()
+
+
+def test_pairs_on_two_processes_give_what_one_gives(monkeypatch):
+    """The designs a search evaluates together go to two forked processes, in
+    order, with the values one process computes."""
+    monkeypatch.setattr(pattern_search, "score", lambda population, d, s, i: _Value(d))
+    designs = [np.full(4, x) for x in (0.1, 0.4, 0.7, 0.9)]
+    with Pairs(None, None, None, workers=1) as one, Pairs(None, None, None, workers=2) as two:
+        here, there = one.score(designs), two.score(designs)
+    assert [v.value for v in here] == [v.value for v in there]
+    assert {v.pid for v in here} == {os.getpid()}
+    assert two.processes == 2 and os.getpid() not in {v.pid for v in there}
