@@ -81,6 +81,9 @@ def test_the_budget_and_the_allowed_region_are_kept():
     d0 = np.full(4, 0.5)
     small = run(d0, max_evaluations=5)
     assert len(small.trials) + 1 <= 5 and not small.lattice_optimum
+    full = run(d0)
+    short = run(d0, max_evaluations=len(full.trials))      # one short of the whole search
+    assert full.lattice_optimum and not short.lattice_optimum
 
     def allowed(d):
         return d[0] + d[3] <= 1.2

@@ -133,10 +133,11 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
 
     k, units = (0,) * len(d0), FIRST_STEP
     while units >= 1 and len(seen) < max_evaluations:
-        any_move = False
+        any_move, cut = False, False
         for i in range(len(d0)):
             tries = [(t, u) for u in (units, -units) if valid(t := step(k, i, u), k)]
             values = evaluate(tries, i, "poll") if tries else []
+            cut = cut or any(v is None for v in values)
             if not values or values[0] is None:
                 continue
             best = 0 if len(values) == 1 or values[1] is None or \
@@ -166,7 +167,8 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
                 take(k)
         if not any_move:
             units //= 2
-    return Searched(point(k), seen[k], trials, units < 1)
+    # a lattice optimum: the last sweep, at one unit, polled every neighbour
+    return Searched(point(k), seen[k], trials, units < 1 and not cut)
 
 
 def search(space: DesignSpace | Population, cap, settings: LoopSettings,
