@@ -100,8 +100,10 @@ def main_job(path: Path, data: dict) -> list[str]:
             ("optimiser's hold (s)", job["optimiser_hold_time_s"]),
             ("baseline's verified hold (s)", job["baseline_hold_time_s"]),
             ("peak finger force (N)", job["max_finger_force_N"]), ("cap (N)", job["cap_N"]),
-            ("outer iterations", job["outer_iterations"]),
-            ("Ipopt iterations", job["ipopt_iterations"]),
+            *([("design loop", "pattern search"),
+               ("search simulations", job["simulations"])] if job.get("method") == "pattern"
+              else [("outer iterations", job["outer_iterations"]),
+                    ("Ipopt iterations", job["ipopt_iterations"])]),
             ("wall time through the API (s)", job["api_wall_time_s"]),
             ("CPU time (s)", profile["cpu_time_s"]),
             ("load average at the start", job["load_average_at_start"][0])]

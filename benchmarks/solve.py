@@ -362,6 +362,8 @@ def main_job() -> dict:
             "optimiser_hold_time_s": result["objective"]["hold_time_s"],
             "baseline_hold_time_s": result["baseline"]["hold_time_s"],
             "max_finger_force_N": v["max_finger_force_N"], "cap_N": v["cap_N"],
+            "method": result["solver"]["method"],
+            "simulations": (result["solver"]["search"] or {}).get("simulations"),
             "ipopt_iterations": result["solver"]["iterations"],
             "outer_iterations": result["solver"]["outer_iterations"],
             "api_wall_time_s": wall, "load_average_at_start": load,
