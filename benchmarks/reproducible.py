@@ -77,7 +77,31 @@ def run(problem: Path, label: str, changes: dict, folder: Path) -> dict:
     return {"label": label, "exit": done.returncode, "wall_time_s": wall,
             "status": result.get("status"), "variables": result.get("variables", []),
             "hold_time_s": result.get("verification", {}).get("hold_time_s"),
-            "numerics": result.get("numerics"), "stderr": done.stderr[-2000:]}
+            "numerics": result.get("numerics"), "stderr": done.stderr[-2000:],
+            "trials": trials(result)}
+
+
+def trials(result: dict) -> list[list[float]]:
+    """The design loop's simulated hold (s) and peak (N) of every design it
+    tried, followed by the design (scaled)."""
+    return [[h["simulated_hold_time_s"], h["simulated_peak_force_N"], *h["candidate_scaled"]]
+            for h in result.get("solver", {}).get("history", [])
+            if "simulated_hold_time_s" in h]
+
+
+def round_off(r: dict, reference: dict) -> dict:
+    """How far the loop's simulations moved under a variation: the largest
+    differences of the tried designs' holds and peaks where both runs tried
+    the same designs (within 1e-6, scaled) in the same order; None where
+    they did not."""
+    a, b = r.get("trials") or [], reference.get("trials") or []
+    same = bool(a) and len(a) == len(b) and all(
+        len(u) == len(v) and max(abs(x - y) for x, y in zip(u[2:], v[2:])) <= 1e-6
+        for u, v in zip(a, b))
+    return {"largest_trial_hold_difference_s":
+            max(abs(u[0] - v[0]) for u, v in zip(a, b)) if same else None,
+            "largest_trial_peak_difference_N":
+            max(abs(u[1] - v[1]) for u, v in zip(a, b)) if same else None}
 
 
 def scaled(variables: list[dict]) -> dict[str, float]:
@@ -121,7 +145,7 @@ def main() -> None:
         rows.append({"variation": r["label"], "status": r["status"],
                      "wall_time_s": round(r["wall_time_s"], 1),
                      "verified_hold_s": r["hold_time_s"], "design_difference": design,
-                     "hold_difference_s": hold,
+                     "hold_difference_s": hold, **round_off(r, reference),
                      "agrees": bool(ok and design <= DESIGN_TOLERANCE
                                     and hold <= HOLD_TOLERANCE)})
     print(f"{'variation':<28} {'status':<22} {'wall (s)':>9} {'hold (s)':>9} "
