@@ -250,9 +250,10 @@ def reproducible(path: Path, data: dict) -> list[str]:
                      lambda r: r.get("largest_trial_peak_difference_N"),
                  "agrees": lambda r: r["agrees"]})]
     if any(r.get("largest_trial_hold_difference_s") for r in data["rows"]):
-        lines += ["", "Where a variation moved the loop's simulations of the designs it tried "
-                  "(the same designs in the same order), the columns 'of a tried design' say by how "
-                  "much: the pattern search's decisions compare holds with a 0.1 ms band ("
+        lines += ["", "Where a variation moved the loop's simulations of the designs it "
+                  "tried (the same designs in the same order), the columns 'of a tried design' "
+                  "say by how much: the pattern search's decisions compare holds with a 0.1 ms "
+                  "band ("
                   "[design method](design-method.md#the-pattern-search-the-same-answer-on-any-"
                   "machine)), wider than those differences."]
     return section("The same answer on another machine", "reproducible", path, data, lines)
