@@ -105,7 +105,10 @@ def main_job(path: Path, data: dict) -> list[str]:
               else [("outer iterations", job["outer_iterations"]),
                     ("Ipopt iterations", job["ipopt_iterations"])]),
             ("wall time through the API (s)", job["api_wall_time_s"]),
-            ("CPU time (s)", profile["cpu_time_s"]),
+            ("CPU time of the run's own process (s)", profile["cpu_time_s"]),
+            *([("CPU time of the search's two processes (s)",
+                job["search_processes_cpu_time_s"])]
+              if job.get("search_processes_cpu_time_s") is not None else []),
             ("load average at the start", job["load_average_at_start"][0])]
     lines += ["", *table([{"q": q, "v": v} for q, v in rows],
                          {"quantity": lambda r: r["q"], "value": lambda r: r["v"]}),

@@ -366,6 +366,8 @@ def main_job() -> dict:
             "max_finger_force_N": v["max_finger_force_N"], "cap_N": v["cap_N"],
             "method": result["solver"]["method"],
             "simulations": (result["solver"]["search"] or {}).get("simulations"),
+            "search_processes_cpu_time_s":
+                (result["solver"]["search"] or {}).get("processes_cpu_time_s"),
             "ipopt_iterations": result["solver"]["iterations"],
             "outer_iterations": result["solver"]["outer_iterations"],
             "api_wall_time_s": wall, "load_average_at_start": load,

@@ -42,6 +42,7 @@ from __future__ import annotations
 import copy
 import multiprocessing
 import os
+import resource
 import time
 from dataclasses import dataclass
 
@@ -244,6 +245,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
                   "simulations": len(found.trials) + 1 + (start is not None),
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes,
+                  "processes_cpu_time_s": pool.children_cpu_time,
                   "caps_N": caps_value(caps)}
     out.wall_time = time.perf_counter() - t0
     return out
@@ -284,11 +286,15 @@ class Pairs:
             not multiprocessing.current_process().daemon
         self.processes = wanted if wanted > 1 and usable else 1
         self.pool = None
+        #: the CPU time (s) of the forked processes, once they have ended
+        #: (this process's own is in the run's profile)
+        self.children_cpu_time = 0.0
 
     def __enter__(self) -> Pairs:
         global _SCORING
         if self.processes > 1:
             _SCORING = self.job
+            self._children_before = _children_cpu()
             self.pool = multiprocessing.get_context("fork").Pool(self.processes)
         return self
 
@@ -298,12 +304,19 @@ class Pairs:
             self.pool.terminate()
             self.pool.join()
             self.pool, _SCORING = None, None
+            self.children_cpu_time = _children_cpu() - self._children_before
 
     def score(self, designs: list) -> list[Scored]:
         if self.pool is None or len(designs) == 1:
             population, settings, integrator = self.job
             return [slim(score(population, d, settings, integrator)) for d in designs]
         return self.pool.map(_score_slim, designs, chunksize=1)
+
+
+def _children_cpu() -> float:
+    """User and system CPU time (s) of this process's ended, waited-for children."""
+    used = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return used.ru_utime + used.ru_stime
 
 
 def keeps(space: DesignSpace, d: np.ndarray, rules: Rules) -> list[bool]:
