@@ -7,6 +7,7 @@ loop simulation is computed once for the KKT, cap-continuation and
 exhaustive-search tests, and the verifications of the baseline and of the
 stiff design once for the verification test and ``design solve``'s."""
 
+import copy
 import json
 from dataclasses import replace
 
@@ -17,8 +18,8 @@ from design.cli import main
 from design.solvers.grasp.simulation import simulate_grasp
 from design.solvers.optimize.schedule import schedule_of
 from design.solvers.optimize.transcription import DesignNLP
-from design.solvers.optimize.trust_region import (Outcome, optimise, score, simulate, verdict,
-                                                verify)
+from design.solvers.optimize.trust_region import (Outcome, better, optimise, score, simulate,
+                                                verdict, verify)
 from tests.design_cases import LOOP, sharing_simulations, short_problem_file, stiffness_space
 
 
@@ -113,6 +114,28 @@ def test_verification_catches_a_design_over_the_cap(shared_simulations):
     assert not failed["passed"] and failed["max_finger_force_N"] > failed["cap_N"] * 1.01
     assert verdict(baseline.hold, baseline, baseline.peak)["passed"]
     assert not verdict(baseline.hold * 1.03, baseline, baseline.peak)["passed"]   # 3% off
+
+
+def test_better_wants_a_gain_over_its_band_and_the_cap_within_its_tolerance(
+        shared_simulations):
+    """The loop's comparison of two simulated designs: the baseline (the
+    previous test's verification run) against itself with its hold 0.2 ms
+    longer. The longer hold beats the other only by more than the band; a
+    cap 0.5 % under their peak keeps both within a 1 % tolerance (the hold
+    decides) and neither without it (the same excess: no winner)."""
+    space = stiffness_space("lower", hi=2.0)
+    base = verify(space, space.scale(space.base_values), LOOP)
+    longer = copy.deepcopy(base)
+    longer.members[0].run.summary["hold_time_s"] += 2e-4
+    roomy = [100.0]
+    assert base.within(roomy) and longer.hold == pytest.approx(base.hold + 2e-4)
+    assert better(longer, base, roomy, band=1e-4)
+    assert not better(longer, base, roomy, band=3e-4)
+    assert not better(base, longer, roomy, band=0.0)
+    cap = [base.peak / 1.005]
+    assert base.within(cap, 0.01) and not base.within(cap, 0.0)
+    assert better(longer, base, cap, tolerance=0.01, band=1e-4)
+    assert not better(longer, base, cap, tolerance=0.0, band=1e-4)
 
 
 def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys,
