@@ -103,6 +103,7 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     lo, hi = -np.ceil(d0 / LATTICE).astype(int), np.ceil((1 - d0) / LATTICE).astype(int)
     seen: dict[tuple, object] = {(0,) * len(d0): value0}
     trials: list[Trial] = []
+    trial_at: dict[tuple, Trial] = {}
 
     def point(k):
         return np.clip(d0 + LATTICE * np.asarray(k), 0.0, 1.0)
@@ -120,14 +121,14 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
         if new:
             for k, v in zip(new, evaluate_many([point(k) for k in new])):
                 seen[k] = v
-                trials.append(Trial(point(k), v, i, dict(tried)[k], move))
+                trial_at[k] = Trial(point(k), v, i, dict(tried)[k], move)
+                trials.append(trial_at[k])
         return [seen.get(k) for k, _ in tried]
 
     def take(k):
-        trial = next(t for t in reversed(trials) if np.array_equal(t.d, point(k)))
-        trial.taken = True
+        trial_at[k].taken = True
         if moved:
-            moved(trial, len(seen))
+            moved(trial_at[k], len(seen))
 
     def valid(t, k) -> bool:
         return t != k and allowed(point(t))
@@ -187,9 +188,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     say = progress or (lambda message: None)
     population = population_of(space)
     caps = np.broadcast_to(np.asarray(cap, float), (len(population.members),)).copy()
-    searching = settings.simulator
-
-    pool = Pairs(population, settings, searching, workers)
+    pool = Pairs(population, settings, settings.simulator, workers)
 
     def simulate_all(designs):
         with profile.phase(SIMULATIONS):
@@ -229,7 +228,8 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     with pool:
         found = compass(simulate_all, origin, first, beats, allowed, max_simulations, moved)
     out = Outcome(found.value, baseline, caps, profile=profile)
-    source = f"the pattern search's simulation (rtol {searching.rtol:g}, steps up to the grid's)"
+    source = (f"the pattern search's simulation (rtol {settings.simulator.rtol:g}, steps up "
+              f"to the grid's)")
     out.claims = [(m.hold, source) for m in found.value.members]
     out.claim = found.value.hold, source
     out.iterations = [{
@@ -241,7 +241,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
                                       "simulated_peak_forces_N": t.value.peaks.tolist()})}
         for n, t in enumerate(found.trials)]
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
-                  "hold_band_s": HOLD_BAND, "rtol": searching.rtol,
+                  "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
                   "simulations": len(found.trials) + 1 + (start is not None),
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes,
