@@ -52,7 +52,8 @@ from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
 from design.solvers.optimize.transcription import Rules, rule_margins
 from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, better,
-                                                   caps_text, caps_value, population_of, score)
+                                                   caps_text, caps_value, check_baseline,
+                                                   population_of, score)
 from design.solvers.optimize.variables import DesignSpace
 
 #: the lattice's unit and the first step, in lattice units (scaled variables)
@@ -205,11 +206,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
                    zip(keeps(population.space, d, rules), kept_at_start))
 
     baseline, = simulate_all([d0])
-    failed = [f"{m.name}: {e.run.summary['message']}" for m, e in
-              zip(population.members, baseline.members) if not e.run.summary["ok"]]
-    if failed:
-        raise ValueError("the baseline's simulation ended early, so no design can start from "
-                         "it: " + "; ".join(failed))
+    check_baseline(population, baseline)
     origin, first = d0, baseline
     if start is not None:
         started, = simulate_all([np.asarray(start, float)])

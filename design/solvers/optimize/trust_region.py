@@ -246,6 +246,22 @@ def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
     return a.excess(caps) < b.excess(caps) - 1e-3
 
 
+def check_baseline(population: Population, baseline: Scored) -> None:
+    """Refuse a baseline whose simulation of some bird ended early: no design
+    loop can start from it.
+
+    Raises
+    ------
+    ValueError
+        Naming each such bird and why its run ended.
+    """
+    failed = [f"{m.name}: {e.run.summary['message']}" for m, e in
+              zip(population.members, baseline.members) if not e.run.summary["ok"]]
+    if failed:
+        raise ValueError("the baseline's simulation ended early, so no design can start from "
+                         "it: " + "; ".join(failed))
+
+
 def population_of(space: DesignSpace | Population) -> Population:
     return space if isinstance(space, Population) else Population.of(space)
 
@@ -265,11 +281,7 @@ def optimise(space: DesignSpace | Population, cap, settings: LoopSettings,
     d0 = population.space.scale(population.space.base_values)
     with profile.phase(SIMULATIONS):
         baseline = score(population, d0, settings)
-    failed = [f"{m.name}: {e.run.summary['message']}" for m, e in
-              zip(population.members, baseline.members) if not e.run.summary["ok"]]
-    if failed:
-        raise ValueError("the baseline's simulation ended early, so no design can start from "
-                         "it: " + "; ".join(failed))
+    check_baseline(population, baseline)
     if start is None:
         best = baseline
     else:
