@@ -160,7 +160,8 @@ def main() -> None:
         "problem": str(problem.relative_to(ROOT)) if problem.is_relative_to(ROOT) else
         str(problem), "tolerances": {"design_scaled": DESIGN_TOLERANCE,
                                      "hold_s": HOLD_TOLERANCE},
-        "rows": rows, "runs": runs, "date": time.strftime("%Y-%m-%d"),
+        "rows": rows, "runs": [{k: v for k, v in r.items() if k != "trials"} for r in runs],
+        "date": time.strftime("%Y-%m-%d"),
         "commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
                                  capture_output=True, text=True).stdout.strip(),
         "machine": {"cpus": os.cpu_count()}})
