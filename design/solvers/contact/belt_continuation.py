@@ -92,24 +92,34 @@ def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
     coef[:, 0] -= 1.0
     values = np.polynomial.polynomial.polyval(GAP_GRID, coef.T)
     k, j = np.unravel_index(int(np.argmin(values)), values.shape)
-    level = np.polynomial.Polynomial(coef[k])
-    slope, curvature = level.deriv(), level.deriv(2)
+    level = coef[k].tolist()
+    slope = [i * c for i, c in enumerate(level)][1:]
+    curvature = [i * c for i, c in enumerate(slope)][1:]
     lo, hi = GAP_GRID[max(j - 1, 0)], GAP_GRID[min(j + 1, GAP_GRID.size - 1)]
-    u = GAP_GRID[j]
+    u = float(GAP_GRID[j])
     for _ in range(20):
-        if curvature(u) <= 0.0:
+        bend = horner(curvature, u)
+        if bend <= 0.0:
             break
-        step = float(np.clip(u - slope(u) / curvature(u), lo, hi))
+        step = float(np.clip(u - horner(slope, u) / bend, lo, hi))
         done, u = step == u, step
         if done:
             break
-    if level(u) > values[k, j]:
-        u = GAP_GRID[j]
+    if horner(level, u) > values[k, j]:
+        u = float(GAP_GRID[j])
     tangent = np.tensordot(np.arange(4) * np.concatenate([[0.0], u ** np.arange(3)]),
                            a[:, :, k], axes=1)
-    return Deepest(float(level(u)), float((chords[:k].sum() + chords[k] * u) / chords.sum()),
+    return Deepest(horner(level, u), float((chords[:k].sum() + chords[k] * u) / chords.sum()),
                    center + np.tensordot(u ** np.arange(4), a[:, :, k], axes=1),
                    tangent / np.linalg.norm(tangent))
+
+
+def horner(coef: list[float], u: float) -> float:
+    """Σ_i coef_i u^i by Horner's rule, as numpy's polyval evaluates it."""
+    value = coef[-1]
+    for c in coef[-2::-1]:
+        value = c + value * u
+    return value
 
 
 @dataclass(frozen=True)
@@ -182,9 +192,13 @@ class BeltedContact:
     n_bird: int
     max_steps: int = 400
 
-    def __init__(self):
+    def __init__(self, compiled_jacobian: bool = False):
         #: Newton solves of the last :meth:`continued`
         self.newton_iterations = 0
+        #: Newton's Jacobians compiled (design.solvers.newton.compiled_jacobian):
+        #: the same iterates, a third faster, after gcc's seconds once per mode
+        #: and machine; for the many simulations of a design search
+        self.compiled_jacobian = compiled_jacobian
         self._calls: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
@@ -339,8 +353,9 @@ class BeltedContact:
         buffers (design/solvers/buffers.py)."""
         if mode not in self._calls:
             tr = self.transcription(mode)
-            self._calls[mode] = (Buffered(tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)),
-                                 Buffered(tr.post), Buffered(tr.shape))
+            newton = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS,
+                                   compiled_jacobian=self.compiled_jacobian)
+            self._calls[mode] = (Buffered(newton), Buffered(tr.post), Buffered(tr.shape))
         return self._calls[mode]
 
     # --------------------------------------------------------- the model's

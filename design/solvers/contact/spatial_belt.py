@@ -42,8 +42,8 @@ class SpatialBeltContact(BeltedContact):
 
     n_bird = 9
 
-    def __init__(self, contact: SpatialContact):
-        super().__init__()
+    def __init__(self, contact: SpatialContact, compiled_jacobian: bool = False):
+        super().__init__(compiled_jacobian)
         self.contact = contact
         self.length = contact.finger.length
         self.tolerance, self.max_steps = contact.tolerance, contact.max_steps
@@ -194,7 +194,7 @@ class SpatialBeltContact(BeltedContact):
         its nodes' quaternions, the tip's by the last interval's end values."""
         nodes = state.z[:self.n_rod].reshape(-1, N_STATE)[:, :4]
         quats = np.vstack([nodes, self.ends @ nodes[-self.tau.size:]])
-        return np.column_stack([quaternion_rotation(q)[:, 0] for q in quats])
+        return quaternion_rotation(quats.T)[:, 0]
 
     def _bird_depth(self, state: Belted) -> float:
         """How deep the finger (not touching the bird) is inside it (m; ≤ 0 outside)."""

@@ -16,8 +16,9 @@ the fixed schedule the NLP only sees the local trade. With the margin, the
 first steps move to designs well inside the cap, where the simulation can
 find the different contact sequences (merged N = 0 windows) that hold
 longer, and the later steps use the slack as the margin closes
-(docs/design-method.md). The schedule (contact and belt modes) is rebuilt around every accepted design,
-so contacts the NLP could not see are found by the simulation.
+(docs/design-method.md). The schedule (contact and belt modes) is rebuilt
+around every accepted design, so contacts the NLP could not see are found
+by the simulation.
 
 A candidate is accepted only if the optimiser's grid reproduces its
 simulation: the NLP with the design fixed, on the design's *own* schedule,
@@ -218,7 +219,8 @@ def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
              integrator: IntegratorSettings | None = None) -> Evaluated:
     """Simulate the scaled design ``d``; its summary (hold, peak force) is
     computed here, once, so that a profile counts it with the simulation."""
-    run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes)
+    run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes,
+                         compiled_jacobian=True)
     run.summary  # noqa: B018  (cached on the run)
     return Evaluated(np.asarray(d, float), run)
 
