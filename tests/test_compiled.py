@@ -250,3 +250,26 @@ def test_buffered_calls_equal_the_function_s_and_do_not_share_outputs():
     assert not np.array_equal(y1, y2)
     with pytest.raises(ValueError, match="input 0 has 2 values, needs 3"):
         call(x1[:2], p)
+
+
+@needs_compiler
+def test_a_rootfinder_with_the_compiled_jacobian_takes_the_same_iterates(cache):
+    """design.solvers.newton.NewtonCache with its Jacobian compiled (what a
+    design search's belt contacts use) lands on the interpreted rootfinder's
+    root to the last bit, from starts that need several damped steps."""
+    from design.solvers.newton import NewtonCache, compiled_jacobian
+    z, q = ca.SX.sym("z", 3), ca.SX.sym("q", 3)
+    r = ca.vertcat(z[0] ** 3 + z[1] - q[0], ca.sin(z[1]) + z[0] * z[2] - q[1],
+                   ca.exp(z[2]) - z[0] - q[2])
+    residual = ca.Function("cubic", [z, q], [r])
+    cache_ = NewtonCache("cubic_newton", residual, "lapacklu",
+                         lambda: compiled_jacobian(residual, "cubic_jac_z"))
+    own = cache_.get(1e-12, 30, False, use_jacobian=False)
+    given = cache_.get(1e-12, 30, False)
+    assert "External" in str(cache_._jacobian)
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        z0, q0 = rng.normal(size=3), rng.normal(size=3)
+        a, b = np.asarray(own(z0, q0)).ravel(), np.asarray(given(z0, q0)).ravel()
+        assert np.array_equal(a, b), (a, b)
+        assert own.stats()["iter_count"] == given.stats()["iter_count"]
