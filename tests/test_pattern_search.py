@@ -119,3 +119,21 @@ def test_pairs_on_two_processes_give_what_one_gives(monkeypatch):
     assert [v.value for v in here] == [v.value for v in there]
     assert {v.pid for v in here} == {os.getpid()}
     assert two.processes == 2 and os.getpid() not in {v.pid for v in there}
+
+
+def test_a_baseline_whose_simulation_ended_early_is_refused_naming_the_bird():
+    """Both design loops start with check_baseline: a bird whose baseline run
+    ended early (a contact that could not be solved) leaves no design to
+    start from; the error names that bird and why, and no other."""
+    from types import SimpleNamespace as Run
+
+    from design.solvers.optimize.trust_region import check_baseline
+    birds = Run(members=[Run(name="small"), Run(name="large")])
+    ran = Run(members=[Run(run=Run(summary={"ok": True, "message": "finished"})),
+                       Run(run=Run(summary={"ok": False,
+                                            "message": "finger 5a failed at 0.91 s"}))])
+    with pytest.raises(ValueError, match=r"no design can start from it: large: finger 5a "
+                                         r"failed at 0\.91 s$"):
+        check_baseline(birds, ran)
+    ran.members[1].run.summary["ok"] = True
+    check_baseline(birds, ran)
