@@ -1,0 +1,83 @@
+"""The main job's scene: wall time per simulated second.
+
+The scene of problems/hold_time.yaml (the arriving mean bird, every finger a
+spatial rod, finger 5 on the belt) at the baseline design, simulated as the
+design search simulates it (rtol 1e-6, steps up to 5 ms, the belt modes'
+Newton Jacobians compiled) and as ``design simulate`` does (the same
+settings, CasADi's own Jacobians: the baseline a user would otherwise run),
+both warm (a first run of each builds its functions and is not timed),
+setup included, the median of three runs. Both must give the same hold and
+peak to the last bit (the same Newton iterates). The target is 1 s of wall
+time per simulated second, the goal 0.5 s.
+
+Prints a table and writes benchmarks/results/scene_speed.json.
+
+    python -m benchmarks.scene_speed
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
+
+from benchmarks.results_file import write_results
+from design.io.scene import load_scene
+from design.run.grasp import setup_of
+from design.solvers.grasp.simulation import simulate_grasp
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = Path(__file__).parent / "results" / "scene_speed.json"
+PROBLEM = ROOT / "problems" / "hold_time.yaml"
+REPEAT = 3
+TARGET, GOAL = 1.0, 0.5
+
+
+def main() -> None:
+    problem = load_scene(PROBLEM)
+    scene = problem.scene
+    settings = problem.settings
+    setup = setup_of(scene)
+    load = os.getloadavg()
+    rows = []
+    for label, compiled in (("design search (compiled Jacobians)", True),
+                            ("design simulate (CasADi's Jacobians)", False)):
+        def once():
+            t0 = time.perf_counter()
+            run = simulate_grasp(setup, settings.simulator, settings.contact_nodes,
+                                 compiled_jacobian=compiled)
+            return time.perf_counter() - t0, run
+        once()                                          # warm: builds its functions
+        walls, runs = zip(*(once() for _ in range(REPEAT)))
+        s = runs[-1].summary
+        wall = statistics.median(walls)
+        rows.append({"simulator": label, "compiled_jacobian": compiled, "wall_s": wall,
+                     "walls_s": list(walls), "simulated_s": setup.duration,
+                     "wall_per_simulated_s": wall / setup.duration,
+                     "hold_time_s": s["hold_time_s"], "max_finger_force_N": s["max_finger_force_N"],
+                     "steps": runs[-1].trajectory.steps, "contact_solves": runs[-1].contact_solves})
+    print(f"{'simulator':38s} {'wall (s)':>8s} {'per simulated s':>15s} {'/ design simulate':>17s} "
+          f"{'hold (s)':>12s} {'peak (N)':>12s}")
+    for r in rows:
+        r["over_design_simulate"] = r["wall_s"] / rows[-1]["wall_s"]
+        print(f"{r['simulator']:38s} {r['wall_s']:8.2f} {r['wall_per_simulated_s']:15.2f} "
+              f"{r['over_design_simulate']:17.3f} {r['hold_time_s']:12.9f} "
+              f"{r['max_finger_force_N']:12.8f}")
+    same = rows[0]["hold_time_s"] == rows[1]["hold_time_s"] and \
+        rows[0]["max_finger_force_N"] == rows[1]["max_finger_force_N"]
+    print(f"\nthe same hold and peak to the last bit: {same}; target {TARGET:g} s per simulated "
+          f"second, goal {GOAL:g}")
+    write_results(RESULTS, {
+        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
+                    "load_average_at_start": load, "load_average_at_end": os.getloadavg()},
+        "problem": str(PROBLEM.relative_to(ROOT)), "repeat": REPEAT,
+        "target_wall_per_simulated_s": TARGET, "goal_wall_per_simulated_s": GOAL,
+        "same_bits": same, "rows": rows})
+
+
+if __name__ == "__main__":
+    main()
