@@ -59,3 +59,19 @@ def test_failures_are_statuses():
 def test_residual_tolerance_stops_at_a_small_residual():
     res = damped_newton(atan_system, np.array([0.1]), 0.0, 50, residual_tolerance=1e-6)
     assert res.converged and abs(res.residual[0]) <= 1e-6
+
+
+def test_a_chord_jacobian_that_is_not_finite_has_no_inverse():
+    """A Jacobian with a NaN (here √(z - 2)'s at z = 1) inverts to NaN
+    without an error; the chord method must not iterate with it (its caller
+    falls back to Newton), and a finite one is inverted."""
+    import casadi as ca
+
+    from design.solvers.newton import Chord
+    z, q = ca.SX.sym("z", 2), ca.SX.sym("q", 1)
+    residual = ca.Function("nan_jacobian", [z, q], [
+        ca.vertcat(ca.sqrt(z[0] - 2) + z[1] - q[0], z[1] - q[0])])
+    chord = Chord(residual)
+    assert chord.inverse(np.array([1.0, 1.0]), np.array([1.0])) is None
+    np.testing.assert_allclose(chord.inverse(np.array([6.0, 1.0]), np.array([1.0])),
+                               [[4.0, -4.0], [0.0, 1.0]], atol=1e-12)

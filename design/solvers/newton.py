@@ -174,11 +174,14 @@ class Chord:
                                               [ca.densify(ca.jacobian(residual(z, q), z))]))
 
     def inverse(self, z: np.ndarray, q: np.ndarray) -> np.ndarray | None:
-        """∂R/∂z inverted at (z, q); None where it is singular."""
+        """∂R/∂z inverted at (z, q); None where it is singular or not finite
+        (a Jacobian with a NaN, e.g. a square root's at 0, inverts to NaN
+        without an error)."""
         try:
-            return np.linalg.inv(self._jacobian(z, q)[0])
+            inverse = np.linalg.inv(self._jacobian(z, q)[0])
         except np.linalg.LinAlgError:
             return None
+        return inverse if np.all(np.isfinite(inverse)) else None
 
     def solve(self, z0: np.ndarray, q: np.ndarray, inverse: np.ndarray, tolerance: float,
               max_iter: int) -> np.ndarray | None:
