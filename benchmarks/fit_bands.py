@@ -1,9 +1,9 @@
 """Which band and which "determined" rule would the fit benches support?
 
-Every bench of tests/fit_benches.py with each kind of reading is refined
-once (the uniform elastica fit, then the path of weights, as ``design fit``
-does); its band is then recomputed under other rules, without fitting
-again:
+Every bench of tests/fit_benches.py with each kind of reading is fitted
+once by ``design fit``'s fit (its data file written and read back, the
+uniform elastica fit, the path of weights); its band is then recomputed
+under other rules, without fitting again:
 
 * the Bayesian band at the chosen weight over ``f`` (1: Wahba's band at the
   chosen weight; 10: the shipped rule, design/calibration/refinement.py's
@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import os
 import platform
+import tempfile
 from multiprocessing import get_context
 from pathlib import Path
 
@@ -36,13 +37,12 @@ import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (
 import numpy as np
 
 from benchmarks.results_file import write_results
-from design.calibration.elastica import uniform_fit
-from design.calibration.refinement import BAND_UNDERSMOOTHING, refine
-from design.run.finger_fit import DETERMINED_BAND
-from tests.fit_benches import FAMILY, READINGS, STEPPED, judged_span, readings
+from design.calibration.refinement import BAND_UNDERSMOOTHING
+from design.io.scene import load_fit
+from design.run.finger_fit import DETERMINED_BAND, fit_finger
+from tests.fit_benches import FAMILY, READINGS, STEPPED, judged_span, write_problem
 
 RESULTS = Path(__file__).parent / "results" / "fit_bands.json"
-KNOTS = 31
 FACTORS = (1.0, 3.0, 10.0)
 BIAS_STEPS = (0, 2)
 THRESHOLDS = (0.10, 0.15, 0.20, 0.25)
@@ -53,12 +53,10 @@ def refined(job: tuple[str, str]) -> dict:
     every rule's band (standard deviations of ln c at each factor, the bias
     terms)."""
     name, which = job
-    data, _, _ = readings(name, which)
-    length = FAMILY[name].length
-    knots = np.linspace(0.0, length, KNOTS)
-    u = uniform_fit(data, length)
-    fit = refine(data, length, knots, np.full(knots.size, 1.0 / u.ei), 1.0 / u.ei,
-                 u.solutions).fit
+    with tempfile.TemporaryDirectory() as folder:
+        problem = load_fit(write_problem(Path(folder), name, which))
+    fit, data = fit_finger(problem).fit, problem.data
+    knots = fit.knots
     sweep = fit.selection.sweep
     chosen = next(i for i, w in enumerate(sweep) if w is fit.selection.chosen)
     out = {"bench": name, "readings": which, "knots": knots, "reach": data.reach,
@@ -112,7 +110,7 @@ def main() -> None:
     write_results(RESULTS, {
         "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
                     "load_average_at_start": load},
-        "fits": len(fits), "knots": KNOTS, "rows": rows})
+        "fits": len(fits), "rows": rows})
 
 
 if __name__ == "__main__":

@@ -6,9 +6,9 @@ design search simulates it (rtol 1e-6, steps up to 5 ms, the belt modes'
 Newton Jacobians compiled) and as ``design simulate`` does (the same
 settings, CasADi's own Jacobians: the baseline a user would otherwise run),
 both warm (a first run of each builds its functions and is not timed),
-setup included, the median of three runs. Both must give the same hold and
-peak to the last bit (the same Newton iterates). The target is 1 s of wall
-time per simulated second, the goal 0.5 s.
+setup included, the median of five runs taken in turn. Both must give the
+same hold and peak to the last bit (the same Newton iterates). The target
+is 1 s of wall time per simulated second, the goal 0.5 s.
 
 Prints a table and writes benchmarks/results/scene_speed.json.
 
@@ -33,7 +33,7 @@ from design.solvers.grasp.simulation import simulate_grasp
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = Path(__file__).parent / "results" / "scene_speed.json"
 PROBLEM = ROOT / "problems" / "hold_time.yaml"
-REPEAT = 3
+REPEAT = 5
 TARGET, GOAL = 1.0, 0.5
 
 
@@ -43,23 +43,30 @@ def main() -> None:
     settings = problem.settings
     setup = setup_of(scene)
     load = os.getloadavg()
+    variants = (("design search (compiled Jacobians)", True),
+                ("design simulate (CasADi's Jacobians)", False))
+
+    def once(compiled: bool):
+        t0 = time.perf_counter()
+        run = simulate_grasp(setup, settings.simulator, settings.contact_nodes,
+                             compiled_jacobian=compiled)
+        return time.perf_counter() - t0, run
+
+    for _, compiled in variants:
+        once(compiled)                                  # warm: builds its functions
+    # interleaved, so that a change in the machine's load falls on both alike
+    timed = [[once(compiled) for _, compiled in variants] for _ in range(REPEAT)]
     rows = []
-    for label, compiled in (("design search (compiled Jacobians)", True),
-                            ("design simulate (CasADi's Jacobians)", False)):
-        def once():
-            t0 = time.perf_counter()
-            run = simulate_grasp(setup, settings.simulator, settings.contact_nodes,
-                                 compiled_jacobian=compiled)
-            return time.perf_counter() - t0, run
-        once()                                          # warm: builds its functions
-        walls, runs = zip(*(once() for _ in range(REPEAT)))
-        s = runs[-1].summary
+    for k, (label, compiled) in enumerate(variants):
+        walls = [t[k][0] for t in timed]
+        run = timed[-1][k][1]
+        s = run.summary
         wall = statistics.median(walls)
         rows.append({"simulator": label, "compiled_jacobian": compiled, "wall_s": wall,
-                     "walls_s": list(walls), "simulated_s": setup.duration,
+                     "walls_s": walls, "simulated_s": setup.duration,
                      "wall_per_simulated_s": wall / setup.duration,
                      "hold_time_s": s["hold_time_s"], "max_finger_force_N": s["max_finger_force_N"],
-                     "steps": runs[-1].trajectory.steps, "contact_solves": runs[-1].contact_solves})
+                     "steps": run.trajectory.steps, "contact_solves": run.contact_solves})
     print(f"{'simulator':38s} {'wall (s)':>8s} {'per simulated s':>15s} {'/ design simulate':>17s} "
           f"{'hold (s)':>12s} {'peak (N)':>12s}")
     for r in rows:
