@@ -2,7 +2,7 @@
 
 The scene of problems/hold_time.yaml (the arriving mean bird, every finger a
 spatial rod, finger 5 on the belt) at the baseline design, simulated as the
-design search simulates it (rtol 1e-6, steps up to 5 ms, the belt modes'
+pattern search simulates it (rtol 1e-6, steps up to 5 ms, the belt modes'
 Newton Jacobians compiled) and as ``design simulate`` does (the same
 settings, CasADi's own Jacobians: the baseline a user would otherwise run),
 both warm (a first run of each builds its functions and is not timed),
@@ -43,7 +43,7 @@ def main() -> None:
     settings = problem.settings
     setup = setup_of(scene)
     load = os.getloadavg()
-    variants = (("design search (compiled Jacobians)", True),
+    variants = (("pattern search (compiled Jacobians)", True),
                 ("design simulate (CasADi's Jacobians)", False))
 
     def once(compiled: bool):
