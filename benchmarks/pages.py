@@ -301,12 +301,13 @@ def scene_speed(path: Path, data: dict) -> list[str]:
              f"median of {data['repeat']} runs; target {data['target_wall_per_simulated_s']:g} s "
              f"of wall time per simulated second, goal {data['goal_wall_per_simulated_s']:g}:",
              "", *table(data["rows"], {
-                 "simulator": lambda r: r["simulator"], "wall (s)": lambda r: r["wall_s"],
+                 "settings": lambda r: r["simulator"], "rtol": lambda r: r["rtol"],
+                 "max step (s)": lambda r: r["max_step_s"], "wall (s)": lambda r: r["wall_s"],
                  "wall per simulated second (s)": lambda r: r["wall_per_simulated_s"],
-                 "/ design simulate": lambda r: r["over_design_simulate"],
+                 "/ scene settings": lambda r: r["over_scene_settings"],
                  "contact solves": lambda r: r["contact_solves"],
-                 "hold (s)": lambda r: r["hold_time_s"]}),
-             "", f"The same hold and peak force to the last bit: {str(data['same_bits']).lower()}."]
+                 "hold (s)": lambda r: r["hold_time_s"],
+                 "peak (N)": lambda r: r["max_finger_force_N"]})]
     return section("The main job's scene: wall time per simulated second", "scene_speed", path,
                    data, lines)
 

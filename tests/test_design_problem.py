@@ -146,6 +146,3 @@ def test_a_problem_built_in_python_runs_with_its_files_settings():
     assert loop.simulator.rtol < scene.integrator.rtol
     assert loop.method == data["solver"]["method"] == "pattern"
     assert design_loop(loop) is search
-    # the search's many simulations compile the belt contacts' Jacobians; the
-    # trust-region loop's few do not wait for gcc
-    assert loop.compiled_jacobian and not replace(loop, method="trust-region").compiled_jacobian

@@ -192,13 +192,9 @@ class BeltedContact:
     n_bird: int
     max_steps: int = 400
 
-    def __init__(self, compiled_jacobian: bool = False):
+    def __init__(self):
         #: Newton solves of the last :meth:`continued`
         self.newton_iterations = 0
-        #: Newton's Jacobians compiled (design.solvers.newton.compiled_jacobian):
-        #: the same iterates, a third faster, after gcc's seconds once per mode
-        #: and machine; for the many simulations of a design search
-        self.compiled_jacobian = compiled_jacobian
         self._calls: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
@@ -353,9 +349,8 @@ class BeltedContact:
         buffers (design/solvers/buffers.py)."""
         if mode not in self._calls:
             tr = self.transcription(mode)
-            newton = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS,
-                                   compiled_jacobian=self.compiled_jacobian)
-            self._calls[mode] = (Buffered(newton), Buffered(tr.post), Buffered(tr.shape))
+            self._calls[mode] = (Buffered(tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)),
+                                 Buffered(tr.post), Buffered(tr.shape))
         return self._calls[mode]
 
     # --------------------------------------------------------- the model's

@@ -48,8 +48,8 @@ class PlanarBeltContact(BeltedContact):
 
     n_bird = 5
 
-    def __init__(self, contact: RobustContact, compiled_jacobian: bool = False):
-        super().__init__(compiled_jacobian)
+    def __init__(self, contact: RobustContact):
+        super().__init__()
         self.contact = contact
         self.length = contact.finger.length
         self.tolerance, self.max_steps = contact.tolerance, contact.max_steps

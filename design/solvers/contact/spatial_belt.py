@@ -42,8 +42,8 @@ class SpatialBeltContact(BeltedContact):
 
     n_bird = 9
 
-    def __init__(self, contact: SpatialContact, compiled_jacobian: bool = False):
-        super().__init__(compiled_jacobian)
+    def __init__(self, contact: SpatialContact):
+        super().__init__()
         self.contact = contact
         self.length = contact.finger.length
         self.tolerance, self.max_steps = contact.tolerance, contact.max_steps

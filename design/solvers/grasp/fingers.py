@@ -177,10 +177,9 @@ class PlanarFinger:
     settles_friction = True
 
     def __init__(self, finger, friction: float, intervals: int, degree: int,
-                 compiled_jacobian: bool = False, reversal_speed: float = REVERSAL_SPEED):
+                 reversal_speed: float = REVERSAL_SPEED):
         self.solver = RobustContact(finger, friction, intervals=intervals, degree=degree,
                                     reversal_speed=reversal_speed)
-        self.compiled_jacobian = compiled_jacobian
         self.reverses = friction > 0 and self.settles_friction
         self._belted: PlanarBeltContact | None = None
 
@@ -188,7 +187,7 @@ class PlanarFinger:
     def belted(self) -> PlanarBeltContact:
         """The solver with the belt (built on first use: most fingers never need it)."""
         if self._belted is None:
-            self._belted = PlanarBeltContact(self.solver, self.compiled_jacobian)
+            self._belted = PlanarBeltContact(self.solver)
         return self._belted
 
     def reversal_margin(self, state, kin_factory) -> float:
@@ -323,10 +322,8 @@ class SpatialFinger:
     #: friction solved with the contact, regularised: nothing to reverse
     reverses = False
 
-    def __init__(self, finger, friction: float, intervals: int, degree: int,
-                 compiled_jacobian: bool = False):
+    def __init__(self, finger, friction: float, intervals: int, degree: int):
         self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
-        self.compiled_jacobian = compiled_jacobian
         self.mu = float(friction)
         self._belted: SpatialBeltContact | None = None
 
@@ -334,7 +331,7 @@ class SpatialFinger:
     def belted(self) -> SpatialBeltContact:
         """The solver with the belt (built on first use: most fingers never need it)."""
         if self._belted is None:
-            self._belted = SpatialBeltContact(self.solver, self.compiled_jacobian)
+            self._belted = SpatialBeltContact(self.solver)
         return self._belted
 
     def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
@@ -439,16 +436,14 @@ class FingerForces:
     def __init__(self, grasper: Grasper, bird: Bird, drum_speed: float, friction: float,
                  windows: list[list[tuple[float, float]]] | None = None,
                  intervals: int = 8, degree: int = 4, model: str = "planar",
-                 belt: Belt = Belt(), belt_friction: float = 0.0,
-                 compiled_jacobian: bool = False):
+                 belt: Belt = Belt(), belt_friction: float = 0.0):
         self.grasper, self.bird = grasper, bird
         self.belt, self.belt_friction = belt, float(belt_friction)
         #: the belt's speed (m/s) at time t; the grasp that drives the belt sets it
         self.belt_speed = lambda t: 0.0
         self.drum = grasper.drum(drum_speed)
         kind = FINGER_MODELS[model]
-        self.models = [kind(gf.finger, friction, intervals, degree, compiled_jacobian)
-                       for gf in grasper.fingers]
+        self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
         self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved

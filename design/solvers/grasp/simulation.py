@@ -76,19 +76,14 @@ class GraspRun:
 
 
 def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = IntegratorSettings(),
-                   contact_nodes: int = 6, reach_filter: bool = True, progress=None,
-                   compiled_jacobian: bool = False) -> GraspRun:
-    """Integrate the symmetric grasp from the bird sitting on the belt at start_x.
-    ``compiled_jacobian``: the belt contacts' Newton Jacobians compiled (the
-    same iterates, faster after compiling once per machine: for a search's
-    many simulations)."""
+                   contact_nodes: int = 6, reach_filter: bool = True, progress=None) -> GraspRun:
+    """Integrate the symmetric grasp from the bird sitting on the belt at start_x."""
     t0 = time.perf_counter()
     b, conv = setup.bird, setup.conveyor
     windows = setup_reach_windows(setup) if reach_filter else None
     fingers = FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction, windows,
                            intervals=contact_nodes, model=setup.finger_model, belt=setup.belt,
-                           belt_friction=setup.finger_belt_friction,
-                           compiled_jacobian=compiled_jacobian)
+                           belt_friction=setup.finger_belt_friction)
     dyn = BirdDynamics(b, setup.legs, setup.conveyor_friction)
     grasp = Grasp(dyn, conv, fingers)
     y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])

@@ -90,14 +90,6 @@ class LoopSettings:
     #: optimize/pattern_search.py: the same answer under round-off)
     method: str = "trust-region"
 
-    @property
-    def compiled_jacobian(self) -> bool:
-        """Whether the loop's simulations compile the belt contacts' Newton
-        Jacobians (the same iterates): the pattern search's hundred and more
-        simulations repay gcc's seconds per mode on a new machine; the
-        trust-region loop's few do not."""
-        return self.method == "pattern"
-
 
 @dataclass
 class Evaluated:
@@ -227,8 +219,7 @@ def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
              integrator: IntegratorSettings | None = None) -> Evaluated:
     """Simulate the scaled design ``d``; its summary (hold, peak force) is
     computed here, once, so that a profile counts it with the simulation."""
-    run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes,
-                         compiled_jacobian=settings.compiled_jacobian)
+    run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes)
     run.summary  # noqa: B018  (cached on the run)
     return Evaluated(np.asarray(d, float), run)
 
