@@ -254,9 +254,10 @@ def test_buffered_calls_equal_the_function_s_and_do_not_share_outputs():
 
 @needs_compiler
 def test_a_rootfinder_with_the_compiled_jacobian_takes_the_same_iterates(cache):
-    """design.solvers.newton.NewtonCache with its Jacobian compiled (what a
-    design search's belt contacts use) lands on the interpreted rootfinder's
-    root to the last bit, from starts that need several damped steps."""
+    """design.solvers.newton.NewtonCache with its Jacobian compiled (the
+    planar contact's rootfinder by default, design/solvers/contact/
+    equations.py) lands on the interpreted rootfinder's root to the last
+    bit, from starts that need several damped steps."""
     from design.solvers.newton import NewtonCache, compiled_jacobian
     z, q = ca.SX.sym("z", 3), ca.SX.sym("q", 3)
     r = ca.vertcat(z[0] ** 3 + z[1] - q[0], ca.sin(z[1]) + z[0] * z[2] - q[1],
