@@ -28,7 +28,6 @@ minutes on 2 cores).
 from __future__ import annotations
 
 import os
-import platform
 import tempfile
 from multiprocessing import get_context
 from pathlib import Path
@@ -36,7 +35,7 @@ from pathlib import Path
 import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
 import numpy as np
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.calibration.refinement import BAND_UNDERSMOOTHING
 from design.io.scene import load_fit
 from design.run.finger_fit import DETERMINED_BAND, fit_finger
@@ -108,8 +107,7 @@ def main() -> None:
                       f"{s['half_or_more']:5d} | {p['wrong']:14d} {p['nothing']:7d} "
                       f"{p['half_or_more']:5d}{'  (shipped)' if row['shipped'] else ''}")
     write_results(RESULTS, {
-        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
-                    "load_average_at_start": load},
+        "machine": machine(load),
         "fits": len(fits), "rows": rows})
 
 

@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import tempfile
 import time
 from pathlib import Path
@@ -38,7 +37,7 @@ from pathlib import Path
 import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
 import numpy as np
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.calibration.convex import fit_compliance
 from design.calibration.elastica import uniform_fit
 from design.calibration.kernel import KnotCompliance, kernel
@@ -184,8 +183,7 @@ def main() -> None:
           + ", ".join(f"{k} {v['smooth_meeting_targets']} of {v['smooth_fits']}"
                       for k, v in summary.items() if isinstance(v, dict)))
     write_results(RESULTS, {
-        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
-                    "load_average_at_start": load},
+        "machine": machine(load),
         "benches": {n: {"length_m": b.length, "profile": b.what, "seed": b.seed,
                         "tuning": n in TUNING, "set": batch(n)} for n, b in FAMILY.items()},
         "judged": "determined knots (band within ±25 %), 10 % of the length off each end, "

@@ -24,10 +24,9 @@ Prints a table and writes benchmarks/results/grasp.json.
 from __future__ import annotations
 
 import os
-import platform
 from pathlib import Path
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.reproduce.grasp import thesis_setup
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import simulate_grasp
@@ -89,8 +88,7 @@ def main() -> None:
     unfiltered = measure(DEFAULT, False, 0.0, 2.0)
     default = rows[0]
     result = {
-        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
-                    "load_average_at_start": load},
+        "machine": machine(load),
         "scenario": "mean bird (Table 5-3), hard lower fingers, t = 0..1 s",
         "timing": "warm: every timed run follows first_run, which builds the CasADi "
                   "functions; wall_s = setup + integration",

@@ -17,14 +17,13 @@ Prints a table and writes benchmarks/results/multistart.json.
 from __future__ import annotations
 
 import os
-import platform
 import tempfile
 import time
 from pathlib import Path
 
 import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.api import solve
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -55,8 +54,7 @@ def main() -> None:
           f"{baseline:.4f} s; {len(ms['optima'])} distinct optima; {wall:.1f} s on {WORKERS} "
           f"workers")
     write_results(RESULTS, {
-        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
-                    "load_average_at_start": load, "load_average_at_end": os.getloadavg()},
+        "machine": machine(load, at_end=True),
         "command": f"design solve {PROBLEM.relative_to(ROOT)} --workers {WORKERS} "
                    "(design.api.solve)",
         "workers": WORKERS, "wall_time_s": wall, "status": result["status"],

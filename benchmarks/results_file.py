@@ -5,10 +5,20 @@ benchmarks/pages.py)."""
 from __future__ import annotations
 
 import json
+import os
+import platform
 from datetime import datetime, timezone
 from pathlib import Path
 
 from design.io.results import jsonable
+
+
+def machine(load_at_start: tuple[float, ...], at_end: bool = False) -> dict:
+    """The ``machine`` entry of a result: Python, cores, the load averages at
+    the start (given) and, with ``at_end``, now."""
+    out = {"python": platform.python_version(), "cores": os.cpu_count(),
+           "load_average_at_start": load_at_start}
+    return {**out, "load_average_at_end": os.getloadavg()} if at_end else out
 
 
 def write_results(path: Path, result: dict) -> None:

@@ -17,14 +17,13 @@ Prints a table and writes benchmarks/results/scene_speed.json.
 from __future__ import annotations
 
 import os
-import platform
 import statistics
 import time
 from pathlib import Path
 
 import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
 from design.solvers.grasp.simulation import simulate_grasp
@@ -75,8 +74,7 @@ def main() -> None:
               f"{r['max_finger_force_N']:12.8f}")
     print(f"\ntarget {TARGET:g} s per simulated second, goal {GOAL:g}")
     write_results(RESULTS, {
-        "machine": {"python": platform.python_version(), "cores": os.cpu_count(),
-                    "load_average_at_start": load, "load_average_at_end": os.getloadavg()},
+        "machine": machine(load, at_end=True),
         "problem": str(PROBLEM.relative_to(ROOT)), "repeat": REPEAT,
         "target_wall_per_simulated_s": TARGET, "goal_wall_per_simulated_s": GOAL,
         "rows": rows})

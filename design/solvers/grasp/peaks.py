@@ -4,8 +4,8 @@ A finger's force is known at the accepted instants only, so its peak, read
 there, is low by up to half a step's worth of its curvature
 (tests/test_peaks.py compares located peaks with a much finer run). Where
 a finger's force at an accepted instant exceeds its neighbours', its
-maximum lies between them: it is found
-by successive parabolic interpolation on the steps' dense output, each
+maximum lies between them: it is found by successive parabolic
+interpolation on the steps' dense output, each
 trial a contact evaluation from the contacts accepted before the step that
 covers it (what the step's own stages continued from). The integration
 itself is left exactly as it was.
