@@ -138,6 +138,36 @@ def test_better_wants_a_gain_over_its_band_and_the_cap_within_its_tolerance(
     assert not better(longer, base, cap, tolerance=0.0, band=1e-4)
 
 
+
+def test_better_orders_jammed_designs_by_how_far_they_are_from_the_rules(shared_simulations):
+    """A search that starts from a design jamming a bird must be able to
+    move: of two jammed designs the one pressing less over its limit is
+    better (by more than 1 mN), an unjammed design over its cap beats a
+    jammed one, and a failed simulation is the worst of all."""
+    space = stiffness_space("lower", hi=2.0)
+    base = verify(space, space.scale(space.base_values), LOOP)
+    cap = [base.peak / 2]
+
+    def variant(extra_force: float = 0.0, jam: bool = True, ok: bool = True):
+        v = copy.deepcopy(base)
+        s = v.members[0].run.summary
+        s["jam"] = list(s["jam"]) + (["the bird is still held off the belt when the run "
+                                      "ends at 1.6 s (by 5b)"] if jam else [])
+        s["max_force_per_finger_N"] = {k: f + extra_force * (f == base.peak)
+                                       for k, f in s["max_force_per_finger_N"].items()}
+        s["ok"] = ok
+        return v
+
+    pressed, harder = variant(), variant(extra_force=5e-3)
+    assert pressed.excess(cap) == np.inf == harder.excess(cap)
+    assert pressed.shortfall(cap) == (0, 1, pytest.approx(base.peak / 2))
+    assert better(pressed, harder, cap) and not better(harder, pressed, cap)
+    assert not better(pressed, variant(extra_force=5e-4), cap)        # within 1 mN
+    free = variant(extra_force=50.0, jam=False)
+    assert better(free, pressed, cap) and not better(pressed, free, cap)
+    failed = variant(jam=False, ok=False)
+    assert better(pressed, failed, cap) and not better(failed, pressed, cap)
+
 def test_a_failed_verification_exits_1_and_says_so(tmp_path, monkeypatch, capsys,
                                                    shared_simulations):
     """End to end through `design solve`: an optimiser that returned a design

@@ -26,7 +26,8 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # finger mesh, by default the scene's contact_nodes;
                                # method: trust-region (default: Ipopt moves the design)
                                # or pattern (the simulator's lattice search, the same
-                               # answer under round-off: pattern_search.py)
+                               # answer under round-off: pattern_search.py); pattern's
+                               # max_simulations: designs simulated (150)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
@@ -330,7 +331,8 @@ def _rules(reader: Reader, value: object) -> Rules | None:
 
 
 #: a design problem's integer solver options: [lowest, highest]
-SOLVER_INTEGERS = {"beam_intervals": (2, 32), "max_iter": (1, 10000), "outer_iterations": (0, 100)}
+SOLVER_INTEGERS = {"beam_intervals": (2, 32), "max_iter": (1, 10000), "outer_iterations": (0, 100),
+                   "max_simulations": (1, 10000)}
 #: its other numeric solver options: dimension, lowest, highest, lowest excluded
 SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
                      "tolerance": ("dimensionless", 1e-12, 1e-2, False),

@@ -61,7 +61,7 @@ LATTICE, FIRST_STEP = 1 / 64, 8
 #: a move must lengthen the hold by more than this (s)
 HOLD_BAND = 1e-4
 #: the default budget of simulations
-MAX_SIMULATIONS = 150
+MAX_SIMULATIONS = LoopSettings.max_simulations
 
 
 @dataclass
@@ -176,15 +176,17 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
 
 def search(space: DesignSpace | Population, cap, settings: LoopSettings,
            rules: Rules = Rules(), start=None, progress=None, anchor: bool = True,
-           max_simulations: int = MAX_SIMULATIONS, workers: int | None = None) -> Outcome:
+           workers: int | None = None) -> Outcome:
     """Maximise the (population's) hold under the cap (N; one per bird, or one
     for all) from ``start`` (scaled; the baseline by default; with ``anchor``
     a start worse than the baseline gives way to it) by :func:`compass`. A
     point that breaks a design rule the baseline keeps is not tried. The
     points evaluated together are simulated by ``workers`` processes (by
     default one per core, at most two: :class:`Pairs`); the answer does not
-    depend on how many."""
+    depend on how many. ``settings.max_simulations`` designs simulated end
+    the search."""
     t0 = time.perf_counter()
+    max_simulations = settings.max_simulations
     profile = Profile()
     say = progress or (lambda message: None)
     population = population_of(space)

@@ -19,7 +19,7 @@ from design.solvers.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
 
 #: a design problem's ``solver`` keys (SI values), each optional
 SOLVER_KEYS = ("method", "time_step", "beam_intervals", "max_iter", "tolerance",
-               "outer_iterations", "trust_region", "cap_margin", "ipopt")
+               "outer_iterations", "trust_region", "cap_margin", "max_simulations", "ipopt")
 #: the design loops a problem may name: Ipopt's trust-region loop
 #: (design/solvers/optimize/trust_region.py) or the pattern search on the
 #: simulator (design/solvers/optimize/pattern_search.py)
@@ -51,4 +51,5 @@ def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
     return LoopSettings(nlp, solver.get("outer_iterations", d.outer_iterations),
                         solver.get("trust_region", d.radius), d.min_radius, simulator, mesh,
                         solver.get("cap_margin", d.cap_margin),
-                        solver.get("method", d.method))
+                        solver.get("method", d.method),
+                        solver.get("max_simulations", d.max_simulations))

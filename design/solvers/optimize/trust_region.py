@@ -89,6 +89,8 @@ class LoopSettings:
     #: "trust-region" (this module's loop) or "pattern" (design/solvers/
     #: optimize/pattern_search.py: the same answer under round-off)
     method: str = "trust-region"
+    #: the pattern search's budget: designs simulated (each for every bird)
+    max_simulations: int = 150
 
 
 @dataclass
@@ -148,17 +150,28 @@ class Scored:
         ``tolerance`` (relative); inf where a bird is held to the end of its
         run or not carried on (a jam no force measures), or where its
         simulation ended early (a failed contact: nothing to judge)."""
-        worst = -np.inf
+        failed, jammed, worst = self.shortfall(caps, tolerance)
+        return np.inf if failed or jammed else worst
+
+    def shortfall(self, caps, tolerance: float = 0.0) -> tuple[int, int, float]:
+        """How far the design is from keeping every rule, the worst first: how
+        many birds' simulations ended early, how many birds are jammed (held
+        to the end of the run or not carried on), and the largest force (N)
+        of any finger of the other birds over its limit, as :meth:`excess`
+        (-inf: no bird to judge)."""
+        failed, jammed, worst = 0, 0, -np.inf
         for m, cap in zip(self.members, np.broadcast_to(np.asarray(caps, float),
                                                         (len(self.members),))):
             s = m.run.summary
-            if not s["ok"] or any(not reason.startswith("finger ") for reason in s["jam"]):
-                return np.inf
+            if not s["ok"]:
+                failed += 1
+                continue
+            jammed += any(not reason.startswith("finger ") for reason in s["jam"])
             limits = finger_limits(m.run.setup, cap)
             peaks = np.array([s["max_force_per_finger_N"][gf.name]
                               for gf in m.run.setup.grasper.fingers])
             worst = max(worst, float(np.max(peaks - limits * (1 + tolerance))))
-        return worst
+        return failed, jammed, worst
 
     def within(self, caps, tolerance: float = 0.0) -> bool:
         """Does every bird stay under its cap (N) and every finger under its
@@ -237,14 +250,19 @@ def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
     under its fold force, no jam; within ``tolerance``, by default the
     verification's, so that a baseline whose own peak is the cap is not
     judged by its rounding) beats infeasible, then the longer hold by more
-    than ``band`` (s); among infeasible designs the smaller largest excess
-    over a limit, by more than 1 mN."""
+    than ``band`` (s); among infeasible designs the one nearer to keeping
+    the rules (:meth:`Scored.shortfall`): fewer failed simulations, then
+    fewer jammed birds, then the smaller largest force over a limit, by more
+    than 1 mN, so that a search from a design that jams a bird can move."""
     fa, fb = a.within(caps, tolerance), b.within(caps, tolerance)
     if fa != fb:
         return fa
     if fa:
         return a.hold > b.hold + band
-    return a.excess(caps) < b.excess(caps) - 1e-3
+    (fail_a, jam_a, over_a), (fail_b, jam_b, over_b) = a.shortfall(caps), b.shortfall(caps)
+    if (fail_a, jam_a) != (fail_b, jam_b):
+        return (fail_a, jam_a) < (fail_b, jam_b)
+    return over_a < over_b - 1e-3
 
 
 def check_baseline(population: Population, baseline: Scored) -> None:
