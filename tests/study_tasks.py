@@ -47,3 +47,18 @@ def interrupted(calls: Path, case: Case, upstream: dict | None, *, at: str) -> d
 def called(calls: Path) -> list[str]:
     """The keys of the calls made, sorted."""
     return sorted(unquote(p.name.split()[0]) for p in calls.iterdir() if p.name != "killed")
+
+
+def forked(case: Case, upstream: dict | None) -> dict:
+    """Squares ``x`` in a pool of two forked processes, as a pattern
+    search's simulations are (design/solvers/optimize/pattern_search.py)."""
+    import multiprocessing
+
+    with multiprocessing.get_context("fork").Pool(2) as pool:
+        squares = pool.map(_square, [case.inputs["x"]] * 2)
+    return {"status": "done", "hold_time_s": float(sum(squares)),
+            "daemon": multiprocessing.current_process().daemon}
+
+
+def _square(x: float) -> float:
+    return x * x

@@ -15,7 +15,7 @@ import pytest
 
 from design.study import Case, StudyOptions, StudyProgress, run_study
 from design.study.store import read_cases
-from tests.study_tasks import called, value
+from tests.study_tasks import called, forked, value
 from tests.test_study_engine import CASES, stripped, task
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -42,6 +42,16 @@ def test_a_local_cluster_returns_the_serial_runs_results(tmp_path, serial, capsy
     assert "running on 2 local worker processes" in err
     assert err.count("Traceback") == 1                     # the failing case's, once
     assert "WARNING" not in err and "distributed." not in err
+
+
+def test_a_local_workers_case_may_fork_its_own_processes():
+    """A case's pattern search simulates in two forked processes; a Dask
+    worker that is a daemon may not have children, so the local workers
+    are not daemons."""
+    cases = [Case(f"x-{x}", {"x": x}) for x in (2, 3)]
+    results = run_study(cases, forked, options=StudyOptions(workers=2), label="fork")
+    assert [(r["status"], r["hold_time_s"], r["daemon"]) for r in results.values()] == \
+        [("done", 8.0, False), ("done", 18.0, False)]
 
 
 def test_a_killed_worker_loses_no_case(tmp_path, serial):

@@ -3,7 +3,10 @@ stopped for the study, or a running scheduler's (``tcp://HOST:PORT``).
 
 The LocalCluster has one worker process per core (or ``workers``, and no
 more than there are cases to run), one thread each, no dashboard, and its
-workers run with one BLAS/OpenMP thread. Its nannies restart a worker
+workers run with one BLAS/OpenMP thread. They are not daemons: a case's
+pattern search may simulate in two forked processes of its own
+(design/solvers/optimize/pattern_search.py), which keeps both cores busy
+when one long case outlasts the others. Its nannies restart a worker
 process that dies, and the scheduler gives the lost case to another worker:
 a case may be lost with its worker :data:`ALLOWED_FAILURES` times before it
 is recorded as an error (a running scheduler applies its own setting,
@@ -57,10 +60,14 @@ def dask_client(options: StudyOptions, cases: int) -> Iterator[tuple[object, str
     the progress line); the LocalCluster, if one was started, is stopped
     after. :class:`StudyError` if the scheduler cannot be reached, or a
     worker runs another version of the toolkit."""
-    from distributed import Client, LocalCluster
+    import dask
+    from distributed import Client
 
     address = scheduler_address(options)
-    with _quiet_dask_logs():
+    # the local workers are not daemons, so that a case's pattern search may
+    # fork its two processes (a population's search outlasts the study's
+    # other cases); the nannies read it as they start a worker, also later
+    with _quiet_dask_logs(), dask.config.set({"distributed.worker.daemon": False}):
         if address:
             try:
                 client = Client(address, timeout=CONNECT_TIMEOUT)
@@ -70,15 +77,7 @@ def dask_client(options: StudyOptions, cases: int) -> Iterator[tuple[object, str
             cluster = None
         else:
             n = min(options.workers or os.cpu_count() or 1, cases)
-            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                   dashboard_address=None, silence_logs=logging.ERROR,
-                                   env=WORKER_ENV, preload=[__name__],
-                                   # the scheduler's HTTP server (health, metrics)
-                                   # starts even without a dashboard, on 8787 unless
-                                   # told otherwise: a second study warned of the port
-                                   scheduler_kwargs={"allowed_failures": ALLOWED_FAILURES,
-                                                     "dashboard": False,
-                                                     "dashboard_address": ":0"})
+            cluster = _local_cluster(n)
             client = Client(cluster)
         try:
             if address:
@@ -92,6 +91,19 @@ def dask_client(options: StudyOptions, cases: int) -> Iterator[tuple[object, str
             client.close()
             if cluster is not None:
                 cluster.close()
+
+
+def _local_cluster(n: int):
+    from distributed import LocalCluster
+
+    return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                        dashboard_address=None, silence_logs=logging.ERROR,
+                        env=WORKER_ENV, preload=[__name__],
+                        # the scheduler's HTTP server (health, metrics) starts
+                        # even without a dashboard, on 8787 unless told
+                        # otherwise: a second study warned of the port
+                        scheduler_kwargs={"allowed_failures": ALLOWED_FAILURES,
+                                          "dashboard": False, "dashboard_address": ":0"})
 
 
 def dask_setup(worker) -> None:
