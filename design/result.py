@@ -184,6 +184,8 @@ class DesignResult(Result):
     #: stiffness scales dimensionless); the baseline's with no improvement
     design: Mapping[str, float] = field(default_factory=dict)
     wall_time_s: float = 0.0
+    #: a throughput problem's answer: birds per minute (None: a hold problem)
+    line_rate_per_min: float | None = None
 
     @property
     def verdict(self) -> str:
@@ -290,7 +292,8 @@ def _design(record: dict, ok: bool) -> dict:
             "optimiser_hold_time_s": record["objective"]["hold_time_s"],
             "baseline_hold_time_s": record["baseline"]["hold_time_s"],
             "max_finger_force_N": v["max_finger_force_N"], "cap_N": v["cap_N"],
-            "design": dict(record["design"]), "wall_time_s": record["wall_time_s"]}
+            "design": dict(record["design"]), "wall_time_s": record["wall_time_s"],
+            "line_rate_per_min": record.get("line_rate_per_min")}
 
 
 def _fit(record: dict, ok: bool) -> dict:

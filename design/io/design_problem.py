@@ -30,12 +30,15 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # max_simulations: designs simulated (150)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
-``groups.<group>.stiffness_scale``, ``conveyor.start_time|rate|final_speed``,
-``drum_speed``, ``spacing`` (design/solvers/optimize/variables.py).
+``groups.<group>.stiffness_scale``, ``conveyor.speed|start_time|rate|final_speed``,
+``drum_speed``, ``spacing``, ``bird_spacing`` (design/solvers/optimize/variables.py;
+at most two of the line's drum_speed, conveyor.speed and bird_spacing, tied by
+eq. 5.3, and only with ``solver: {method: pattern}``).
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -46,21 +49,24 @@ from design.io.grasp_scene import GraspScene, read_bird
 from design.io.reader import Reader, did_you_mean, join
 from design.physics.bird import Bird
 from design.solvers.optimize.finger_load import STAGE_MODELS
+from design.solvers.optimize.line import max_sets
 from design.solvers.optimize.model_check import CHECK_MODEL
 from design.solvers.optimize.policy import LOOP_METHODS, SOLVER_KEYS, loop_settings
 from design.solvers.optimize.population import AGGREGATES
 from design.solvers.optimize.transcription import Rules
 from design.solvers.optimize.trust_region import LoopSettings
 from design.solvers.optimize.variables import (CONVEYOR_FIELDS, FINGER_FIELDS, GLOBAL_FIELDS,
-                                             GROUP_FIELDS)
+                                             GROUP_FIELDS, LINE)
 
+#: a design problem's objectives: the longest hold, the highest line rate
+OBJECTIVES = ("hold", "throughput")
 #: starting designs of ``multistart: {}`` (the baseline and seven Sobol points)
 DEFAULT_STARTS = 8
 
 DIMENSIONS = {"angle": "angle", "phi_x": "angle", "phi_y": "angle", "length": "length",
               "height": "length", "stiffness_scale": "dimensionless", "start_time": "time",
-              "rate": "acceleration", "final_speed": "speed", "drum_speed": "angular_speed",
-              "spacing": "length"}
+              "rate": "acceleration", "final_speed": "speed", "speed": "speed",
+              "drum_speed": "angular_speed", "spacing": "length", "bird_spacing": "length"}
 
 
 @dataclass(frozen=True)
@@ -120,6 +126,12 @@ class DesignProblem:
     #: baseline and optimum also simulated in the perturbed scenes of
     #: design/solvers/optimize/robustness.py
     robustness: bool = False
+    #: ``hold`` (the longest hold) or ``throughput`` (the highest line rate
+    #: with every bird held at least ``min_hold`` s: design/run/line.py)
+    objective: str = "hold"
+    min_hold: float = 0.0
+    #: a throughput problem's numbers of finger sets, each a case (eq. 5.4)
+    finger_sets: tuple[int, ...] = ()
 
     @property
     def pareto(self) -> bool:
@@ -128,8 +140,10 @@ class DesignProblem:
     @property
     def settings(self) -> LoopSettings:
         """The settings the design loop runs with: :attr:`solver` under the
-        solve layer's policy (:func:`design.solvers.optimize.policy.loop_settings`)."""
-        return loop_settings(self.solver, self.scene.settings)
+        solve layer's policy (:func:`design.solvers.optimize.policy.loop_settings`),
+        with the problem's objective."""
+        return replace(loop_settings(self.solver, self.scene.settings),
+                       objective=self.objective, min_hold=self.min_hold)
 
 
 def variable_names(scene: GraspScene) -> list[str]:
@@ -151,6 +165,17 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         if "population" in data else None
     multistart = _multistart(reader, data["multistart"]) if "multistart" in data \
         else MultistartSpec()
+    line = [name for name in LINE if name in (variables or {})]
+    if line and solver is not None and solver.get("method") != "pattern":
+        reader.add("solver.method", f"{', '.join(line)} move the bird's arrival with the line "
+                   "(eq. 5.3), which only the simulator follows: give method: pattern")
+    if scene is not None and (line or data.get("objective") == "throughput"):
+        period = 2 * math.pi / (scene.grasper.sets * scene.drum_speed)
+        if scene.duration <= period:
+            reader.add("scene.duration", f"{scene.duration:g} s: a line that moves needs the "
+                       "bird arriving, one finger-set period upstream of where it meets its "
+                       f"set (2 pi / (n omega) = {period:.3g} s), and a run that goes on after "
+                       "it (design/solvers/optimize/variables.py)")
     if scene is not None and scene.finger_model not in STAGE_MODELS:
         reader.add("scene.finger_model", f"'{scene.finger_model}' is for simulations only: the "
                    f"design NLP models {' and '.join(STAGE_MODELS)} fingers")
@@ -159,13 +184,51 @@ def read_design(reader: Reader, data: dict, base_dir: Path, name: str) -> Design
         else ("none",)
     model_check = reader.choice(data, "model_check", "", checks, default=checks[0])
     robustness = reader.boolean(data, "robustness", "", default=False)
+    objective, min_hold, finger_sets = _line(reader, data, scene, solver, caps, multistart)
     if not reader.ok or None in (scene, variables, caps, rules, solver, multistart,
-                                 model_check, robustness) or \
+                                 model_check, robustness, objective) or \
             ("population" in data and population is None):
         return None
     return DesignProblem(name, scene, variables, caps, rules, solver,
                          data.get("description", ""), population, multistart, model_check,
-                         robustness)
+                         robustness, objective, min_hold, finger_sets)
+
+
+def _line(reader: Reader, data: dict, scene: GraspScene | None, solver: dict | None,
+          caps: list | None, multistart: MultistartSpec | None) -> tuple:
+    """``objective``, ``min_hold`` (s) and ``finger_sets`` (a throughput
+    problem's; eq. 5.4 bounds the sets by the grasper's included angle)."""
+    objective = reader.choice(data, "objective", "", OBJECTIVES, default="hold")
+    line = {key: data[key] for key in ("min_hold", "finger_sets") if key in data}
+    if objective != "throughput":
+        for key in line:
+            reader.add(key, "only a throughput problem has it (objective: throughput)")
+        return objective, 0.0, ()
+    duration = scene.duration if scene is not None else None
+    min_hold = reader.quantity(data, "min_hold", "", "time", lo=0.0, lo_open=True,
+                               hi=duration)
+    if solver is not None and solver.get("method") != "pattern":
+        reader.add("solver.method", "a throughput problem is solved by the pattern search: "
+                   "give method: pattern")
+    if caps is not None and len(caps) > 1:
+        reader.add("cap", "a throughput problem takes one cap")
+    if multistart is not None and multistart.starts > 1:
+        reader.add("multistart", "a throughput problem starts from its baseline only")
+    sets: tuple[int, ...] = ()
+    if "finger_sets" in data and scene is not None:
+        top = max_sets(scene.grasper)
+        given = data["finger_sets"] if isinstance(data["finger_sets"], list) \
+            else [data["finger_sets"]]
+        for i, n in enumerate(given):
+            if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= top:
+                reader.add(join("finger_sets", i), f"expected an integer from 1 to {top} "
+                           f"(eq. 5.4: 2 pi / the sets' included angle), got {n!r}")
+        if not given:
+            reader.add("finger_sets", f"an empty list (allowed: 1 to {top}, eq. 5.4)")
+        elif len(set(map(str, given))) != len(given):
+            reader.add("finger_sets", "a number of sets is repeated")
+        sets = tuple(given)
+    return objective, min_hold, sets
 
 
 def _scene(reader: Reader, value: object, base_dir: Path) -> GraspScene | None:
@@ -214,7 +277,8 @@ def _variables(reader: Reader, value: object, scene: GraspScene | None):
         if dimension is None or (allowed is not None and key not in allowed):
             reader.add(path, f"no such design variable (allowed: fingers.<name>.<"
                              f"{'|'.join(FINGER_FIELDS)}>, groups.<group>.stiffness_scale, "
-                             f"conveyor.<{'|'.join(CONVEYOR_FIELDS)}>, drum_speed, spacing)"
+                             f"conveyor.<{'|'.join(CONVEYOR_FIELDS)}>, "
+                             f"{', '.join(GLOBAL_FIELDS)})"
                              f"{did_you_mean(key, allowed or list(DIMENSIONS))}")
             continue
         values = reader.quantities(spec, key, "variables", dimension)
@@ -225,13 +289,18 @@ def _variables(reader: Reader, value: object, scene: GraspScene | None):
         elif not values[0] < values[1]:
             reader.add(path, f"lower bound {values[0]:g} is not below upper bound {values[1]:g}")
         elif key.endswith(("stiffness_scale", "rate", "length", "drum_speed", "spacing",
-                           "final_speed")) and values[0] <= 0:
+                           "speed")) and values[0] <= 0:
             reader.add(path, f"lower bound {values[0]:g} must be > 0")
         elif key in base and not values[0] <= base[key] <= values[1]:
             reader.add(path, f"the bounds [{values[0]:g}, {values[1]:g}] do not contain the "
                              f"baseline's value {base[key]:g} (SI)")
         else:
             out[key] = (values[0], values[1])
+    if all(name in spec for name in LINE):
+        reader.add("variables", f"{', '.join(LINE)} are tied by eq. 5.3 (2 pi v = n dx "
+                                "omega): at most two of them may be variables, the third "
+                                "follows")
+        return None
     return out
 
 

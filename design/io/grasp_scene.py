@@ -31,7 +31,7 @@ from design.io.reader import Reader, join
 from design.physics.beam import Finger
 from design.physics.belt import Belt
 from design.physics.bird import Bird, Conveyor, Legs
-from design.physics.grasper import GraspFinger, Grasper
+from design.physics.grasper import GraspFinger, Grasper, mounted_sets
 from design.physics.kinematics import FingerMount
 from design.solvers.grasp.fingers import FINGER_MODELS
 from design.solvers.grasp.integrate import INTEGRATORS, STEPPERS, IntegratorSettings
@@ -84,21 +84,6 @@ def _grasper(reader: Reader, data: object, field_name: str, base_dir: Path,
         return None
     return Grasper(mounted_sets(fingers, sets), spacing, tilt, x,
                    spec.get("name", default_name), sets)
-
-
-def mounted_sets(fingers: list[GraspFinger], sets: int) -> tuple[GraspFinger, ...]:
-    """Each designed finger mounted ``sets`` times, 2π/sets apart (thesis eqs.
-    5.3-5.4: n finger sets around a drum); copies are named with a set
-    letter, ``4a``, ``4b``, ...; one set keeps the designed names."""
-    if sets == 1:
-        return tuple(fingers)
-    out = []
-    for k in range(sets):
-        phase = 2 * np.pi * k / sets
-        for gf in fingers:
-            out.append(replace(gf, name=f"{gf.name}{'abcdefghijkl'[k]}", family=gf.name,
-                               phase=phase, mount=replace(gf.mount, angle=gf.mount.angle + phase)))
-    return tuple(out)
 
 
 def read_finger_models(reader: Reader, data: dict, field_name: str, base_dir: Path

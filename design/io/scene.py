@@ -29,7 +29,8 @@ KINDS = {
               ("finger_models", "mounts", "friction", "legs", "finger_model", "solver", "belt"),
               read_grasp),
     "design": (("scene", "variables"), ("cap", "rules", "solver", "population",
-                                         "multistart", "model_check", "robustness"),
+                                         "multistart", "model_check", "robustness",
+                                         "objective", "min_hold", "finger_sets"),
                read_design),
 }
 MODEL_KINDS = ("finger", *MODEL_READERS)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+import numpy as np
+
 from design.physics.beam import Finger
 from design.physics.kinematics import Drum, FingerMount
 
@@ -66,6 +68,13 @@ class Grasper:
             fingers.append(replace(gf, mount=replace(gf.mount, **change)) if change else gf)
         return replace(self, fingers=tuple(fingers))
 
+    def with_sets(self, sets: int) -> "Grasper":
+        """The grasper with ``sets`` finger sets, 2π/sets apart, each the
+        designed set (eqs. 5.3-5.4)."""
+        designed = [replace(gf, name=gf.design_name, family="", phase=0.0)
+                    for gf in self.fingers if gf.phase == 0.0]
+        return replace(self, fingers=mounted_sets(designed, sets), sets=sets)
+
     def with_finger(self, index: int, finger: GraspFinger) -> "Grasper":
         fingers = list(self.fingers)
         fingers[index] = finger
@@ -78,3 +87,18 @@ class Grasper:
                              "drum_radius": f.mount.radius, "phi_x": f.mount.phi_x,
                              "phi_y": f.mount.phi_y, "stiffness": f.finger.stiffness.describe()}
                             for f in self.fingers]}
+
+
+def mounted_sets(fingers: list[GraspFinger], sets: int) -> tuple[GraspFinger, ...]:
+    """Each designed finger mounted ``sets`` times, 2π/sets apart (thesis eqs.
+    5.3-5.4: n finger sets around a drum); copies are named with a set
+    letter, ``4a``, ``4b``, ...; one set keeps the designed names."""
+    if sets == 1:
+        return tuple(fingers)
+    out = []
+    for k in range(sets):
+        phase = 2 * np.pi * k / sets
+        for gf in fingers:
+            out.append(replace(gf, name=f"{gf.name}{'abcdefghijkl'[k]}", family=gf.name,
+                               phase=phase, mount=replace(gf.mount, angle=gf.mount.angle + phase)))
+    return tuple(out)

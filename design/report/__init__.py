@@ -15,6 +15,7 @@ def build_report(output: RunOutput) -> Page:
     from design.report.beam_contact import beam_page, contact_page
     from design.report.design import design_page
     from design.report.grasp import grasp_page
+    from design.report.line import line_page
 
     r, a = output.result, output.artifacts
     if r["kind"] == "beam":
@@ -23,6 +24,8 @@ def build_report(output: RunOutput) -> Page:
         return contact_page(r)
     if r["kind"] == "grasp":
         return grasp_page(r, a["run"])
+    if "line" in r:
+        return line_page(r, a["baseline"], a["optimum"])
     return design_page(r, a["baseline"], a["optimum"])
 
 

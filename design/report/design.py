@@ -113,7 +113,7 @@ def population_section(page: Page, population: dict) -> None:
               f"), robust optimum {holds['robust_optimum']:.4f} s "
               f"({limiting['robust_optimum']}). Every number is from the independent "
               f"simulation at 4x the optimiser's resolution.")
-    page.table(population["birds"], "Hold (s) and peak finger force (N) of every bird",
+    page.table(population["birds"], "Hold (s), peak finger force (N) and jam of every bird",
                "population-table")
 
 

@@ -101,8 +101,12 @@ def run(problem: DesignProblem, progress: Progress | None = None,
     spatial model check and the robustness table's runs go to a background
     process (``check``).
     The cases run through design/study (``study``: where, and the case
-    store); a study of one chain runs in this process. Every BLAS runs one
+    store); a study of one chain runs in this process. A throughput problem
+    runs as design/run/line.py says. Every BLAS runs one
     thread (design/solvers/reproducible.py): the same answer on any machine."""
+    if problem.objective == "throughput":
+        from design.run import line
+        return line.run(problem, progress, study)
     background = problem.model_check != "none" or problem.robustness
     with one_blas_thread(), ModelCheck(problem.settings.simulator) if background \
             else nullcontext() as check:
@@ -324,7 +328,12 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
         kept.profiles[case.key] = outcome.profile
     return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
             "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
-            "peaks_N": fine.peaks.tolist(), "hold_time_s": fine.hold}
+            "peaks_N": fine.peaks.tolist(), "jams": jams(fine), "hold_time_s": fine.hold}
+
+
+def jams(scored: Scored) -> list[str]:
+    """Each bird's jam: why its grasp is a jam ("; "-joined), or ``none``."""
+    return ["; ".join(m.run.summary["jam"]) or "none" for m in scored.members]
 
 
 def design_loop(settings):
@@ -376,16 +385,19 @@ def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[st
 
 def population_comparison(space: DesignSpace, population: Population, baseline: Scored,
                           single: dict, fine: Scored, caps: np.ndarray) -> dict:
-    """Each bird's hold and peak under the baseline, the single-bird optimum
-    (the scene's own bird alone, at its cap) and the robust optimum, all
-    verified at 4x the optimiser's resolution."""
+    """Each bird's hold, peak and jam under the baseline, the single-bird
+    optimum (the scene's own bird alone, at its cap) and the robust optimum,
+    all verified at 4x the optimiser's resolution."""
     designs = {"baseline": (baseline.holds, baseline.peaks),
                "single_bird_optimum": (np.array(single["holds_s"]), np.array(single["peaks_N"])),
                "robust_optimum": (fine.holds, fine.peaks)}
+    jammed = {"baseline": jams(baseline), "single_bird_optimum": single["jams"],
+              "robust_optimum": jams(fine)}
     rows = [{"bird": member.name, "weight": float(population.weights[b]),
              "cap_N": float(caps[b]),
              **{f"{label}_{key}": float(values[i][b]) for label, values in designs.items()
-                for i, key in enumerate(("hold_time_s", "max_finger_force_N"))}}
+                for i, key in enumerate(("hold_time_s", "max_finger_force_N"))},
+             **{f"{label}_jam": jammed[label][b] for label in designs}}
             for b, member in enumerate(population.members)]
     return {"objective": population.aggregate, "single_bird": space.baseline.bird.name,
             "single_bird_cap_N": single["cap_N"], "single_bird_design": single["design"],
@@ -486,6 +498,8 @@ def status_line(result: dict) -> str:
     peak = f"peak finger force {v['max_finger_force_N']:.2f} N (cap {v['cap_N']:.2f} N)"
     if status == ERROR:
         return f"error: {result['message']}"
+    if "line" in result:
+        return f"{status}: {result['message']}"
     if status == NO_IMPROVEMENT:
         known = result.get("population", {}).get("better_known")
         return (f"no improvement found: the design is the baseline, unchanged; hold "

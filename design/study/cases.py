@@ -103,11 +103,12 @@ def ordered(cases: list[Case]) -> list[Case]:
 
 
 def case_row(key: str, result: dict) -> dict:
-    """A finished case as a table row: key, status, ``hold_time_s`` and
-    ``max_finger_force_N`` when the result has them, the message of a case
+    """A finished case as a table row: key, status, ``line_rate_per_min``,
+    ``hold_time_s`` and ``max_finger_force_N`` when the result has them, the message of a case
     that failed, wall time (s) and worker."""
     row = {"key": key, "status": result["status"]}
-    row.update({name: result[name] for name in ("hold_time_s", "max_finger_force_N")
+    row.update({name: result[name] for name in ("line_rate_per_min", "hold_time_s",
+                                                "max_finger_force_N")
                 if result.get(name) is not None})
     if result["status"] in FAILED:
         row["message"] = result.get("message", "")

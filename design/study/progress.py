@@ -2,6 +2,7 @@
 
     <label>: cases done/total, best verified hold so far, elapsed, about T left
 
+(or the best verified line rate, for a line-speed study: ``goal``)
 (on a terminal; otherwise one plain line per finished case), and a table of
 the cases at the end. The time left is the elapsed time per case run so
 far (cases from the store excluded) times the cases left, so it counts
@@ -23,10 +24,15 @@ from design.study.cases import FAILED, case_row
 
 #: (row field, column header, format) of the case tables, in order; a column
 #: is shown when some row has its field
-COLUMNS = (("key", "key", "{}"), ("status", "status", "{}"), ("hold_time_s", "hold (s)", "{:.4f}"),
+COLUMNS = (("key", "key", "{}"), ("status", "status", "{}"),
+           ("line_rate_per_min", "rate (birds/min)", "{:.1f}"), ("hold_time_s", "hold (s)", "{:.4f}"),
            ("max_finger_force_N", "peak (N)", "{:.2f}"), ("wall_time_s", "wall time (s)", "{:.1f}"),
            ("worker", "worker", "{}"), ("finished_at", "finished (UTC)", "{}"),
            ("message", "message", "{}"))
+
+#: what a study's progress line calls best: (result field, words, format)
+HOLD = ("hold_time_s", "best verified hold", "{:.4f} s")
+RATE = ("line_rate_per_min", "best verified rate", "{:.1f} birds/min")
 
 #: the width of a table written to a file or pipe (a terminal's is its own)
 PIPED_WIDTH = 200
@@ -34,11 +40,12 @@ PIPED_WIDTH = 200
 
 class StudyProgress:
     """Shows a running study (see the module docstring); ``quiet`` shows
-    nothing. ``live``: None, a live line when ``stream`` is a terminal."""
+    nothing. ``live``: None, a live line when ``stream`` is a terminal;
+    ``goal``: what the line calls best (:data:`HOLD`, :data:`RATE`)."""
 
     def __init__(self, quiet: bool = False, stream: TextIO | None = None,
-                 live: bool | None = None):
-        self.quiet = quiet
+                 live: bool | None = None, goal: tuple = HOLD):
+        self.quiet, self.goal = quiet, goal
         self.console = console(stream or sys.stderr)
         self.live = self.console.is_terminal if live is None else live
         self._display: Live | None = None
@@ -67,9 +74,11 @@ class StudyProgress:
         self.done, self.ran = self.done + 1, self.ran + 1
         self._note(result)
         if not self.quiet and not self.live:
+            rate = f", {result['line_rate_per_min']:.1f} birds/min" \
+                if result.get("line_rate_per_min") is not None else ""
             hold = f", hold {result['hold_time_s']:.4f} s" \
                 if result.get("hold_time_s") is not None else ""
-            self.console.print(f"{key}: {result['status']}{hold}; {self.line()}")
+            self.console.print(f"{key}: {result['status']}{rate}{hold}; {self.line()}")
 
     def traceback(self, key: str, text: str) -> None:
         """A case's task raised: its traceback (shown even when quiet)."""
@@ -90,18 +99,19 @@ class StudyProgress:
     def line(self) -> Text:
         """The progress line now."""
         elapsed = time.monotonic() - self.t0
-        best = f"{self.best:.4f} s" if self.best is not None else "none yet"
+        _, words, form = self.goal
+        best = form.format(self.best) if self.best is not None else "none yet"
         left = f"about {_duration(elapsed / self.ran * (self.total - self.done))} left" \
             if self.ran and self.done < self.total else \
             ("done" if self.done >= self.total else "time left not known yet")
-        return Text(f"{self.label}: cases {self.done}/{self.total}, best verified hold "
+        return Text(f"{self.label}: cases {self.done}/{self.total}, {words} "
                     f"{best}, elapsed {_duration(elapsed)}, {left}")
 
     def _note(self, result: dict) -> None:
-        hold = result.get("hold_time_s")
-        if hold is not None and result.get("verified", True) and result["status"] not in FAILED \
-                and (self.best is None or hold > self.best):
-            self.best = hold
+        value = result.get(self.goal[0])
+        if value is not None and result.get("verified", True) and \
+                result["status"] not in FAILED and (self.best is None or value > self.best):
+            self.best = value
 
 
 def console(stream: TextIO) -> Console:

@@ -48,6 +48,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
 from design.solvers.optimize.transcription import Rules, rule_margins
@@ -198,6 +199,8 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             return pool.score(designs)
 
     def beats(a: Scored, b: Scored) -> bool:
+        if settings.objective == "throughput":
+            return faster(a, b, caps, settings.min_hold, HOLD_BAND)
         return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
 
     d0 = population.space.scale(population.space.base_values)
@@ -220,9 +223,11 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         f"{LATTICE:g} of each box")
 
     def moved(trial: Trial, count: int):
+        line = f"{rate_of(trial.value):.1f} birds/min, " \
+            if settings.objective == "throughput" else ""
         say(f"step {abs(trial.units) * LATTICE:g}: {names[trial.variable]} "
-            f"{'up' if trial.units > 0 else 'down'} -> hold {trial.value.hold:.4f} s, peak "
-            f"{trial.value.peak:.2f} N ({count} simulations)")
+            f"{'up' if trial.units > 0 else 'down'} -> {line}hold {trial.value.hold:.4f} s, "
+            f"peak {trial.value.peak:.2f} N ({count} simulations)")
 
     with pool:
         found = compass(simulate_all, origin, first, beats, allowed, max_simulations, moved)
@@ -237,7 +242,10 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
         **({} if len(caps) == 1 else {"simulated_hold_times_s": t.value.holds.tolist(),
-                                      "simulated_peak_forces_N": t.value.peaks.tolist()})}
+                                      "simulated_peak_forces_N": t.value.peaks.tolist()}),
+        **({} if settings.objective != "throughput" else {
+            "line_rate_per_min": rate_of(t.value), "keeps_limits": t.value.within(caps),
+            "jammed_birds": t.value.shortfall(caps)[1]})}
         for n, t in enumerate(found.trials)]
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,

@@ -568,7 +568,7 @@ def rule_margins(values: dict, setup, rules: Rules) -> list:
     if rules.bird_spacing is not None:
         sets = rules.finger_sets or len({gf.phase for gf in setup.grasper.fingers})
         ratio = sets * rules.bird_spacing / (2 * np.pi)
-        gap = setup.conveyor.speed / values["drum_speed"] - ratio
+        gap = values["conveyor.speed"] / values["drum_speed"] - ratio
         out += [(gap + 1e-6, "rule 5.3: v/omega"), (1e-6 - gap, "rule 5.3: v/omega")]
     return out
 

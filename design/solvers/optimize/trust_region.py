@@ -91,6 +91,10 @@ class LoopSettings:
     method: str = "trust-region"
     #: the pattern search's budget: designs simulated (each for every bird)
     max_simulations: int = 150
+    #: ``hold`` (the longest hold) or ``throughput`` (the highest line rate
+    #: with every bird held ``min_hold`` s: design/solvers/optimize/line.py)
+    objective: str = "hold"
+    min_hold: float = 0.0
 
 
 @dataclass

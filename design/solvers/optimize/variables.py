@@ -7,7 +7,19 @@ Every parameter has a name and an SI value in the baseline design:
   multiplied by this factor (a new E for the same shape);
 * ``conveyor.start_time | rate | final_speed`` (s, m/s², m/s): the belt
   slows from its speed at ``rate`` to ``final_speed`` from ``start_time`` on;
-* ``drum_speed`` (rad/s), ``spacing`` (m, between the drum axes).
+* ``drum_speed`` (rad/s), ``spacing`` (m, between the drum axes);
+* the line: ``drum_speed`` ω, ``conveyor.speed`` v (m/s, the belt's speed
+  before it slows) and ``bird_spacing`` Δx (m, between consecutive birds)
+  are tied by eq. 5.3, 2π v = n Δx ω (n finger sets): at most two of them
+  are variables and the third follows (Δx if it is not one, else v). A
+  line that moves keeps the bird meeting its finger set as in the baseline
+  scene: the bird starts Δx upstream of where the baseline's bird is one
+  finger-set period 2π/(nω) after the start; the run lasts that period plus
+  the baseline's time after it or the time the drum takes to turn as far,
+  whichever is longer (a faster drum turns further, a slower one as far,
+  and the bird always has the baseline's time to fall back onto the belt);
+  a belt that does not slow stays at its new speed (one that slows keeps
+  its final speed, rate and start).
 
 A :class:`DesignSpace` lists the variables with bounds; the optimiser works
 on scaled variables d ∈ [0, 1] (d = 0 the lower bound), numbers or CasADi
@@ -26,8 +38,11 @@ from design.solvers.grasp.simulation import GraspSetup
 
 FINGER_FIELDS = {"angle": "rad", "phi_x": "rad", "phi_y": "rad", "length": "m", "height": "m"}
 GROUP_FIELDS = {"stiffness_scale": "1"}
-CONVEYOR_FIELDS = {"start_time": "s", "rate": "m/s^2", "final_speed": "m/s"}
-GLOBAL_FIELDS = {"drum_speed": "rad/s", "spacing": "m"}
+CONVEYOR_FIELDS = {"speed": "m/s", "start_time": "s", "rate": "m/s^2", "final_speed": "m/s"}
+GLOBAL_FIELDS = {"drum_speed": "rad/s", "spacing": "m", "bird_spacing": "m"}
+#: the line's parameters tied by eq. 5.3, in the order the one that follows
+#: from the others is chosen (the first that is not a variable)
+LINE = ("bird_spacing", "conveyor.speed", "drum_speed")
 
 
 @dataclass(frozen=True)
@@ -72,10 +87,30 @@ def parameters_of(setup: GraspSetup) -> dict[str, float]:
     for group in groups(setup):
         values[f"groups.{group}.stiffness_scale"] = 1.0
     c = setup.conveyor
-    values.update({"conveyor.start_time": c.start_time, "conveyor.rate": c.rate,
-                   "conveyor.final_speed": c.final_speed, "drum_speed": setup.drum_speed,
-                   "spacing": setup.grasper.spacing})
+    values.update({"conveyor.speed": c.speed, "conveyor.start_time": c.start_time,
+                   "conveyor.rate": c.rate, "conveyor.final_speed": c.final_speed,
+                   "drum_speed": setup.drum_speed, "spacing": setup.grasper.spacing,
+                   "bird_spacing": bird_spacing(c.speed, setup.drum_speed, setup.grasper.sets)})
     return values
+
+
+def bird_spacing(speed: float, drum_speed: float, sets: int):
+    """Δx (m) of eq. 5.3, 2π v = n Δx ω, at belt speed v (m/s), drum speed ω
+    (rad/s) and n finger sets."""
+    return 2 * np.pi * speed / (sets * drum_speed)
+
+
+def tied(values: dict, base: dict, follows: str) -> dict:
+    """``values`` with the line parameter ``follows`` (one of :data:`LINE`)
+    set by eq. 5.3 from the other two, as its ``base`` value times their
+    ratios to theirs (exactly the base value where they are theirs)."""
+    out = dict(values)
+    ratio = {name: out[name] / base[name] for name in LINE}
+    out[follows] = base[follows] * {
+        "bird_spacing": lambda r: r["conveyor.speed"] / r["drum_speed"],
+        "conveyor.speed": lambda r: r["bird_spacing"] * r["drum_speed"],
+        "drum_speed": lambda r: r["conveyor.speed"] / r["bird_spacing"]}[follows](ratio)
+    return out
 
 
 def groups(setup: GraspSetup) -> list[str]:
@@ -92,6 +127,13 @@ class DesignSpace:
         for v in self.variables:
             if v.name not in self.base_values:
                 raise KeyError(v.name)
+        names = {v.name for v in self.variables}
+        line = [n for n in LINE if n in names]
+        if len(line) == len(LINE):
+            raise ValueError(f"{', '.join(LINE)} are tied by eq. 5.3: at most two of them "
+                             "may be variables")
+        #: the line parameter that follows from the others (None: the line is fixed)
+        self.follows = next(n for n in LINE if n not in names) if line else None
 
     @property
     def size(self) -> int:
@@ -110,7 +152,7 @@ class DesignSpace:
         out = dict(self.base_values)
         for i, v in enumerate(self.variables):
             out[v.name] = v.lo + d[i] * (v.hi - v.lo)
-        return out
+        return tied(out, self.base_values, self.follows) if self.follows else out
 
     def scale(self, values: dict) -> np.ndarray:
         """Scaled variables of a numeric design, clipped to [0, 1]."""
@@ -139,6 +181,27 @@ def apply(setup: GraspSetup, values: dict) -> GraspSetup:
                                mount=mount))
     grasper = replace(setup.grasper, fingers=tuple(fingers), spacing=values["spacing"])
     c = setup.conveyor
-    conveyor = Conveyor(c.speed, values["conveyor.final_speed"], values["conveyor.rate"],
-                        values["conveyor.start_time"])
-    return replace(setup, grasper=grasper, conveyor=conveyor, drum_speed=values["drum_speed"])
+    speed, drum_speed = values["conveyor.speed"], values["drum_speed"]
+    final = values["conveyor.final_speed"]
+    if final == c.speed == c.final_speed:                   # a belt that does not slow
+        final = speed
+    conveyor = Conveyor(speed, final, values["conveyor.rate"], values["conveyor.start_time"])
+    out = replace(setup, grasper=grasper, conveyor=conveyor, drum_speed=drum_speed)
+    if (speed, drum_speed) == (c.speed, setup.drum_speed):
+        return out
+    return synchronised(out, setup)
+
+
+def synchronised(setup: GraspSetup, baseline: GraspSetup) -> GraspSetup:
+    """``setup``, whose line (belt and drum speed) differs from the
+    baseline's, with the bird meeting its finger set as in the baseline: it
+    starts Δx upstream of where the baseline's bird is one finger-set period
+    after the start, and the run covers that period and the baseline's time
+    or turn of the drum after it, the longer (module docstring)."""
+    sets = baseline.grasper.sets
+    period = 2 * np.pi / (sets * setup.drum_speed)
+    base_period = 2 * np.pi / (sets * baseline.drum_speed)
+    dx = bird_spacing(setup.conveyor.speed, setup.drum_speed, sets)
+    met = baseline.start_x + baseline.conveyor.speed * base_period
+    after = (baseline.duration - base_period) * max(1.0, baseline.drum_speed / setup.drum_speed)
+    return replace(setup, start_x=met - dx, duration=period + after)
