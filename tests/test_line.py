@@ -16,7 +16,7 @@ from design.run.line import pareto
 from design.solvers.optimize.line import faster, included_angle, max_sets, rate
 from design.solvers.optimize.trust_region import verify
 from design.solvers.optimize.variables import (DesignSpace, Variable, parameters_of,
-                                              timed_conveyor)
+                                              synchronised, timed_conveyor)
 from tests.design_cases import LOOP, sharing_simulations, stiffness_space
 
 SCENE = Path(__file__).resolve().parents[1] / "problems" / "grasp_mean_bird_hard_spatial.yaml"
@@ -130,6 +130,18 @@ def test_more_sets_are_the_designed_set_mounted_again(baseline):
     assert angles["3a"] == pytest.approx(baseline.grasper.fingers[2].mount.angle)
     assert angles["3b"] - angles["3a"] == pytest.approx(np.pi / 2)
     assert four.with_sets(3) == baseline.grasper
+
+
+def test_more_sets_meet_the_bird_where_the_scene_does(baseline):
+    """Four sets at the same drum and belt speed: the bird starts one
+    (shorter) period upstream of where the three-set scene's bird meets its
+    set, and the 0.457 m/s belt now carries birds 0.343 m apart."""
+    four = synchronised(replace(baseline, grasper=baseline.grasper.with_sets(4)), baseline)
+    period3, period4 = 2 * np.pi / (3 * baseline.drum_speed), 2 * np.pi / (4 * baseline.drum_speed)
+    v = baseline.conveyor.speed
+    assert four.start_x + v * period4 == pytest.approx(baseline.start_x + v * period3, abs=1e-12)
+    assert parameters_of(four)["bird_spacing"] == pytest.approx(0.457 * 3 / 4, rel=1e-3)
+    assert four.duration - period4 == pytest.approx(baseline.duration - period3)
 
 
 def fake(base, drum_rpm: float, hold: float, extra_force: float = 0.0, jam: bool = False):

@@ -36,7 +36,8 @@ from design.solvers.optimize.pattern_search import search
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.trust_region import (CAP_TOLERANCE, HOLD_TOLERANCE, Scored,
                                                 population_verdict, verify)
-from design.solvers.optimize.variables import DesignSpace, Variable, parameters_of
+from design.solvers.optimize.variables import (DesignSpace, Variable, parameters_of,
+                                             synchronised)
 from design.solvers.reproducible import numerics, one_blas_thread
 from design.study.cases import FAILED as CASE_FAILED
 from design.study.cases import Case, StudyOptions
@@ -86,10 +87,14 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
 
 
 def sets_population(problem: DesignProblem, n: int) -> tuple[DesignSpace, Population]:
-    """The problem's design space and population with ``n`` finger sets (the
-    variables' bounds as stated, their baseline values those of n sets)."""
+    """The problem's design space and population with ``n`` finger sets, the
+    bird meeting its set as in the scene (the variables' bounds as stated,
+    their baseline values those of n sets)."""
     space = design_space(problem)
-    setup = replace(space.baseline, grasper=space.baseline.grasper.with_sets(n))
+    if n == space.baseline.grasper.sets:
+        return space, population_of_problem(problem, space)
+    setup = synchronised(replace(space.baseline, grasper=space.baseline.grasper.with_sets(n)),
+                         space.baseline)
     base = parameters_of(setup)
     space = DesignSpace(setup, [Variable(v.name, v.lo, v.hi, base[v.name])
                                 for v in space.variables])

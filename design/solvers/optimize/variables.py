@@ -193,15 +193,15 @@ def apply(setup: GraspSetup, values: dict) -> GraspSetup:
 
 
 def synchronised(setup: GraspSetup, baseline: GraspSetup) -> GraspSetup:
-    """``setup``, whose line (belt and drum speed) differs from the
-    baseline's, with the bird meeting its finger set as in the baseline: it
-    starts Δx upstream of where the baseline's bird is one finger-set period
-    after the start, and the run covers that period and the baseline's time
-    or turn of the drum after it, the longer (module docstring)."""
-    sets = baseline.grasper.sets
-    period = 2 * np.pi / (sets * setup.drum_speed)
-    base_period = 2 * np.pi / (sets * baseline.drum_speed)
-    dx = bird_spacing(setup.conveyor.speed, setup.drum_speed, sets)
+    """``setup``, whose line (belt and drum speed, finger sets) differs from
+    the baseline's, with the bird meeting its finger set as in the
+    baseline: it starts Δx upstream of where the baseline's bird is one
+    finger-set period after the start, and the run covers the new period
+    and the baseline's time or turn of the drum after it, the longer
+    (module docstring)."""
+    period = 2 * np.pi / (setup.grasper.sets * setup.drum_speed)
+    base_period = 2 * np.pi / (baseline.grasper.sets * baseline.drum_speed)
     met = baseline.start_x + baseline.conveyor.speed * base_period
     after = (baseline.duration - base_period) * max(1.0, baseline.drum_speed / setup.drum_speed)
-    return replace(setup, start_x=met - dx, duration=period + after)
+    return replace(setup, start_x=met - setup.conveyor.speed * period,
+                   duration=period + after)
