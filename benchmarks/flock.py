@@ -1,0 +1,98 @@
+"""The whole flock: one design for Table 5-5's birds, and the line's rate.
+
+``population``: ``design solve problems/hold_time_population.yaml`` through
+the public API, each bird verified at 4x finer resolution; the baseline a
+user would otherwise have is the thesis's design, and the mean bird's own
+optimum (the same search on the design bird alone, in the same run) is
+beside it: per bird, the hold, peak and jam of each.
+
+``line``: ``design solve problems/line_speed.yaml``: per number of finger
+sets the highest verified rate (birds/min) with every bird held the
+problem's ``min_hold`` under the cap, against the thesis's 60 birds/min (the
+baseline design, measured in the same run), and the Pareto front.
+
+Each prints a table and writes its entry of benchmarks/results/flock.json
+(the other entry is kept), with the wall time and the number of workers.
+
+    python -m benchmarks.flock population [--workers 2]
+    python -m benchmarks.flock line [--workers 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import tempfile
+import time
+from pathlib import Path
+
+import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
+
+from benchmarks.results_file import machine, write_results
+from design.api import solve
+
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = Path(__file__).parent / "results" / "flock.json"
+PROBLEMS = {"population": ROOT / "problems" / "hold_time_population.yaml",
+            "line": ROOT / "problems" / "line_speed.yaml"}
+
+
+def population_entry(result: dict) -> dict:
+    p = result["population"]
+    labels = ("baseline", "single_bird_optimum", "robust_optimum")
+    print(f"\n{'bird':20s}" + "".join(f" {label + ' hold/peak/jam':>44s}" for label in labels))
+    for b in p["birds"]:
+        print(f"{b['bird']:20s}" + "".join(
+            f" {b[f'{label}_hold_time_s']:8.4f} s {b[f'{label}_max_finger_force_N']:7.2f} N "
+            f"{'jam' if b[f'{label}_jam'] != 'none' else 'no jam':>6s}" + " " * 15
+            for label in labels))
+    return {"cap_N": result["cap"]["N"], "birds": p["birds"],
+            "hold_time_s": p["hold_time_s"], "limiting_bird": p["limiting_bird"],
+            "single_bird_design": p["single_bird_design"], "robust_design": result["design"],
+            "simulations": result["solver"]["search"]["simulations"]}
+
+
+def line_entry(result: dict) -> dict:
+    line = result["line"]
+    print(f"\n{'sets':>4s} {'status':28s} {'rate (1/min)':>12s} {'rpm':>6s} {'belt (m/s)':>10s} "
+          f"{'dx (m)':>7s} {'worst hold':>10s} {'peak (N)':>8s}")
+    for r in line["cases"]:
+        print(f"{r['finger_sets']:4d} {r['status']:28s} {r['line_rate_per_min']:12.1f} "
+              f"{r['drum_speed_rpm']:6.1f} {r['belt_speed_m_s']:10.3f} {r['bird_spacing_m']:7.3f} "
+              f"{r['worst_hold_time_s']:8.4f} s {r['max_finger_force_N']:8.2f}")
+    base = line["baseline"]["line_rate_per_min"]
+    return {"cap_N": result["cap"]["N"], "min_hold_s": result["objective"]["min_hold_s"],
+            "baseline_rate_per_min": base, "answer_rate_per_min": result["line_rate_per_min"],
+            "answer_over_baseline": result["line_rate_per_min"] / base,
+            "cases": line["cases"], "limit": line["limit"], "baseline": line["baseline"],
+            "optimum_birds": line["optimum_birds"], "design": result["design"],
+            "pareto": result["pareto"]}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("study", choices=sorted(PROBLEMS))
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args()
+    problem = PROBLEMS[args.study]
+    load = os.getloadavg()
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as out:
+        result = solve(problem, out=out, workers=args.workers,
+                       progress=lambda message: print(f"  {message}", flush=True)).to_dict()
+    wall = time.perf_counter() - t0
+    entry = (population_entry if args.study == "population" else line_entry)(result)
+    print(f"\n{result['status']}: {result['message']}\n{wall:.1f} s on {args.workers} workers")
+    kept = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
+    kept.pop("measured_at", None)
+    write_results(RESULTS, {**kept, args.study: {
+        "machine": machine(load, at_end=True),
+        "command": f"design solve {problem.relative_to(ROOT)} --workers {args.workers} "
+                   "(design.api.solve)",
+        "workers": args.workers, "wall_time_s": wall, "status": result["status"],
+        "message": result["message"], **entry}})
+
+
+if __name__ == "__main__":
+    main()
