@@ -25,6 +25,7 @@ import json
 import os
 import tempfile
 import time
+from datetime import datetime, timezone
 from pathlib import Path
 
 import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (design/__init__.py)
@@ -87,6 +88,7 @@ def main() -> None:
     kept = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     kept.pop("measured_at", None)
     write_results(RESULTS, {**kept, args.study: {
+        "measured_at": datetime.now(timezone.utc).date().isoformat(),
         "machine": machine(load, at_end=True),
         "command": f"design solve {problem.relative_to(ROOT)} --workers {args.workers} "
                    "(design.api.solve)",

@@ -329,9 +329,50 @@ def multistart(path: Path, data: dict) -> list[str]:
     return section("The main job from eight starts", "multistart", path, data, lines)
 
 
+def population(path: Path, data: dict) -> list[str]:
+    p = data.get("population")
+    if p is None:
+        return []
+    labels = {"baseline": "baseline", "single_bird_optimum": "mean bird's optimum",
+              "robust_optimum": "robust optimum"}
+    columns = {"bird": lambda r: r["bird"]}
+    for key, words in labels.items():
+        columns.update({f"{words}: hold (s)": lambda r, k=key: r[f"{k}_hold_time_s"],
+                        f"{words}: peak (N)": lambda r, k=key: r[f"{k}_max_finger_force_N"],
+                        f"{words}: jam": lambda r, k=key: r[f"{k}_jam"]})
+    lines = [f"`{p['command']}`: {p['status']} in {p['wall_time_s']:.0f} s on {p['workers']} "
+             f"workers ({p['simulations']} designs simulated for every bird), one cap "
+             f"{p['cap_N']:.2f} N for all: {p['message']}", "", "Each bird at 4x finer "
+             "resolution:", "", *table(p["birds"], columns)]
+    return section("The flock: one design for Table 5-5's birds", "flock population", path, p,
+                   lines)
+
+
+def line_speed(path: Path, data: dict) -> list[str]:
+    q = data.get("line")
+    if q is None:
+        return []
+    lines = [f"`{q['command']}`: {q['status']} in {q['wall_time_s']:.0f} s on {q['workers']} "
+             f"workers: {q['message']}. The baseline (the thesis's design) runs "
+             f"{q['baseline_rate_per_min']:.0f} birds/min; every bird must be held "
+             f"{q['min_hold_s']:g} s under {q['cap_N']:.2f} N without a jam. What limits the "
+             f"answer: {q['limit']}.", "", *table(q["cases"], {
+                 "finger sets": lambda r: r["finger_sets"], "status": lambda r: r["status"],
+                 "rate (birds/min)": lambda r: r["line_rate_per_min"],
+                 "drum (rpm)": lambda r: r["drum_speed_rpm"],
+                 "belt (m/s)": lambda r: r["belt_speed_m_s"],
+                 "bird spacing (m)": lambda r: r["bird_spacing_m"],
+                 "worst hold (s)": lambda r: r["worst_hold_time_s"],
+                 "peak (N)": lambda r: r["max_finger_force_N"],
+                 "wall (s)": lambda r: r["wall_time_s"]}),
+             "", f"Pareto front (rate, worst hold, peak; jams excluded): {len(q['pareto'])} "
+             "designs."]
+    return section("The line's rate for the flock", "flock line", path, q, lines)
+
+
 #: results file -> its sections' makers
 PAGES = {"solve.json": [main_job, nlp_sizes], "scene_speed.json": [scene_speed],
-         "multistart.json": [multistart],
+         "multistart.json": [multistart], "flock.json": [population, line_speed],
          "reproducible.json": [reproducible],
          "grasp.json": [grasp],
          "spatial_mesh.json": [spatial_mesh], "beam.json": [beam],
