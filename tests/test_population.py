@@ -10,6 +10,7 @@ in the scaled design and 1e-4 s in hold, against the 0.36-0.67 s holds and
 the [0, 1] box of the short grasp (tests/design_cases.py).
 """
 
+import copy
 from dataclasses import replace
 
 import numpy as np
@@ -21,7 +22,8 @@ from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, sta
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.schedule import schedule_of
 from design.solvers.optimize.transcription import DesignNLP, NLPSettings
-from design.solvers.optimize.trust_region import simulate
+from design.run.solve import population_comparison
+from design.solvers.optimize.trust_region import simulate, verify
 from tests import prefetch
 from tests.design_cases import LOOP, sharing_simulations, stiffness_space
 
@@ -178,3 +180,24 @@ def test_a_better_known_single_bird_design_is_named_not_adopted():
                                "cap_N": 23.6},
               "population": {"better_known": note}}
     assert status_line(result).endswith(note)
+
+
+def test_the_population_table_gives_each_designs_hold_peak_and_jam():
+    """Per bird, the baseline's, the single-bird optimum's and the robust
+    optimum's hold, peak and jam (its reasons, or ``none``), as simulated."""
+    space = stiffness_space("lower", hi=2.0)
+    with sharing_simulations():
+        base = verify(space, space.scale(space.base_values), LOOP)
+    robust = copy.deepcopy(base)
+    reason = "the bird is still held off the belt when the run ends at 1.000 s (by 5b)"
+    robust.members[0].run.summary["jam"] = [reason]
+    single = {"holds_s": [0.25], "peaks_N": [17.5], "jams": ["none"], "cap_N": 20.0,
+              "design": {}}
+    table = population_comparison(space, Population.of(space), base, single, robust,
+                                  np.array([20.0]))
+    row, = table["birds"]
+    assert row["baseline_jam"] == ("; ".join(base.run.summary["jam"]) or "none")
+    assert (row["single_bird_optimum_jam"], row["robust_optimum_jam"]) == ("none", reason)
+    assert (row["single_bird_optimum_hold_time_s"], row["robust_optimum_hold_time_s"]) == \
+        (0.25, base.hold)
+    assert row["robust_optimum_max_finger_force_N"] == base.peak
