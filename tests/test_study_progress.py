@@ -4,6 +4,7 @@ best verified hold, a summary table at the end; quiet shows nothing."""
 import io
 
 from design.study import Case, StudyOptions, StudyProgress, run_study
+from design.study.progress import RATE
 
 CASES = [Case("a", {"hold": 0.2, "verified": True}), Case("b", {"hold": 0.5, "verified": False}),
          Case("c", {"hold": 0.3, "verified": True}, after="a")]
@@ -46,3 +47,25 @@ def test_the_summary_table_has_every_case():
 
 def test_quiet_shows_nothing():
     assert shown(quiet=True) == ""
+
+
+def rated(case, upstream):
+    """A line rate and worst hold as the inputs say; verified or not."""
+    return {**held(case, upstream), "line_rate_per_min": case.inputs["rate"]}
+
+
+def test_a_line_study_shows_the_best_verified_rate():
+    """A throughput study's line gives the best verified rate (birds/min),
+    not the longest hold; an unverified faster case is not the best."""
+    cases = [Case("sets-3", {"hold": 0.3, "verified": True, "rate": 90.0}),
+             Case("sets-4", {"hold": 0.2, "verified": False, "rate": 120.0}),
+             Case("sets-5", {"hold": 0.21, "verified": True, "rate": 100.0})]
+    stream = io.StringIO()
+    run_study(cases, rated, options=StudyOptions(workers=1), label="line",
+              progress=StudyProgress(stream=stream, goal=RATE))
+    lines = stream.getvalue().splitlines()
+    assert lines[1].startswith("sets-3: verified, 90.0 birds/min, hold 0.3000 s; line: cases "
+                               "1/3, best verified rate 90.0 birds/min")
+    assert "best verified rate 90.0 birds/min" in lines[2]
+    assert "best verified rate 100.0 birds/min" in lines[3]
+    assert "rate (birds/min)" in stream.getvalue()
