@@ -8,18 +8,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
+
+import design
 
 from design.errors import ProblemFileError
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
 from design.run.line import pareto
-from design.solvers.optimize.line import faster, included_angle, max_sets, rate
+from design.solvers.optimize.line import broken, faster, included_angle, max_sets, rate
 from design.solvers.optimize.trust_region import verify
 from design.solvers.optimize.variables import (DesignSpace, Variable, parameters_of,
                                               synchronised, timed_conveyor)
 from tests.design_cases import LOOP, sharing_simulations, stiffness_space
 
 SCENE = Path(__file__).resolve().parents[1] / "problems" / "grasp_mean_bird_hard_spatial.yaml"
+MODELS = SCENE.parents[1] / "models"
 RPM = 2 * np.pi / 60
 
 
@@ -178,6 +182,19 @@ def test_throughput_ranks_rules_then_rate_then_hold(shared_simulations):
     assert faster(fake(base, 40, 0.06), short_fast, cap, asked, 1e-4)  # nearer the hold
 
 
+def test_the_rules_a_design_breaks_are_named_by_bird_finger_and_rule(shared_simulations):
+    space = stiffness_space("lower", hi=2.0)
+    base = verify(space, space.scale(space.base_values), LOOP)
+    bird = base.population.members[0].name
+    assert broken(base, [base.peak * 1.5], 0.0) == []
+    finger = base.run.summary["max_finger_force_finger"]
+    named = broken(fake(base, 20, 0.05, extra_force=base.peak, jam=True),
+                   [base.peak * 1.5], 0.1)
+    assert named[0] == f"{bird}: the bird is still held off the belt when the run ends"
+    assert any(n.startswith(f"{bird}: finger {finger} presses") for n in named)
+    assert named[-1] == f"{bird}: held 0.0500 s, under the 0.1 s asked"
+
+
 def test_the_pareto_front_keeps_only_undominated_unjammed_designs():
     rows = [{"line_rate_per_min": r, "hold_time_s": h, "max_finger_force_N": p,
              "jammed_birds": j} for r, h, p, j in
@@ -204,3 +221,35 @@ def test_line_problems_refuse_bad_input_by_field(change, field):
     with pytest.raises(ProblemFileError) as info:
         load_scene({**base, **change})
     assert any(p.field == field for p in info.value.problems), str(info.value)
+
+
+@pytest.mark.slow
+def test_a_line_study_end_to_end(tmp_path):
+    """``design solve`` of a small throughput problem (the planar finger, one
+    bird, two numbers of sets, eight designs each): every case's rate is 60 n
+    omega / 2 pi of its design, the answer is the fastest verified case, the
+    Pareto front is undominated, and the files are written."""
+    problem = {"kind": "design", "name": "line_small",
+               "scene": {**{k: v for k, v in yaml.safe_load(SCENE.read_text()).items()
+                            if k not in ("kind", "name", "description")},
+                         "finger_model": "planar", "grasper": str(MODELS / "graspers" /
+                                                                 "thesis_table_5_1.yaml"),
+                         "bird": str(MODELS / "birds" / "mean_1_80kg.yaml"),
+                         "conveyor": str(MODELS / "conveyors" / "constant_0457.yaml")},
+               "objective": "throughput", "min_hold": "0.1 s", "finger_sets": [3, 4],
+               "variables": {"drum_speed": ["20 rpm", "40 rpm"],
+                             "groups.lower.stiffness_scale": [0.5, 2.0]},
+               "cap": {"relative_to_baseline": 1.5}, "model_check": "none",
+               "solver": {"method": "pattern", "max_simulations": 8}}
+    result = design.solve(problem, out=tmp_path, workers=1).to_dict()
+    cases = result["line"]["cases"]
+    for case in cases:
+        assert case["line_rate_per_min"] == pytest.approx(
+            case["finger_sets"] * case["drum_speed_rpm"], rel=1e-12)
+    verified = [c for c in cases if c["status"] == "verified"]
+    if verified:
+        assert result["line_rate_per_min"] == max(c["line_rate_per_min"] for c in verified)
+    front = result["pareto"]
+    assert front and pareto(front) == front
+    for name in ("result.json", "line.csv", "pareto.csv", "birds.csv", "report.html"):
+        assert (tmp_path / name).exists()

@@ -8,7 +8,9 @@ resolution. A case's design keeps the rules when, in the verification,
 every bird is under the cap (within its 1 %), no finger past its fold
 force, no bird jammed, and every bird held at least ``min_hold`` (within the
 verification's 2 % on the hold). The run's answer is the case with the
-highest rate that keeps them (then the longest worst hold).
+highest rate that keeps them (then the longest worst hold); what limits
+it is what the nearest faster design the search simulated breaks (which
+bird, which finger, which rule), or the drum speed's bound.
 
 result.json's ``line`` has every case and the baseline; ``pareto`` the
 designs the searches simulated that no other beats on all three of rate,
@@ -31,7 +33,7 @@ from design.run import Progress, RunOutput
 from design.run.grasp import timeseries
 from design.run.solve import (VERIFIED, design_bird_peak, design_space,
                               population_of_problem, problem_digest)
-from design.solvers.optimize.line import KILL_LINE_RATE, THESIS_RATE, rate_of
+from design.solvers.optimize.line import KILL_LINE_RATE, THESIS_RATE, broken, rate_of
 from design.solvers.optimize.pattern_search import search
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.trust_region import (CAP_TOLERANCE, HOLD_TOLERANCE, Scored,
@@ -118,6 +120,7 @@ def solve_sets(problem: DesignProblem, progress: Progress | None, case: Case,
               NO_DESIGN if not searched_kept else Status.FAILED_VERIFICATION)
     rate = rate_of(fine)
     return {"status": str(status), "sets": n, "line_rate_per_min": rate,
+            "limit": faster_limit(outcome, problem.min_hold, space),
             "message": _case_message(status, n, rate, fine, problem.min_hold),
             "d": outcome.best.d.tolist(), "design": space.design(outcome.best.d),
             "line": line_of(space, outcome.best.d),
@@ -201,7 +204,7 @@ def _output(problem: DesignProblem, space: DesignSpace, population: Population,
     rows = [{"case": k, "finger_sets": r["sets"], "status": r["status"],
              "line_rate_per_min": r["line_rate_per_min"], "worst_hold_time_s": r["hold_time_s"],
              "max_finger_force_N": r["max_finger_force_N"], **r["line"],
-             "message": r["message"], "wall_time_s": r["wall_time_s"]}
+             "limit": r["limit"], "message": r["message"], "wall_time_s": r["wall_time_s"]}
             for k, r in results.items()]
     trials = [dict(t, finger_sets=r["sets"]) for r in results.values() for t in r["trials"]]
     front = pareto(trials)
@@ -242,7 +245,7 @@ def _output(problem: DesignProblem, space: DesignSpace, population: Population,
                               "birds": bird_rows(population, baseline)},
                  "optimum_birds": best["birds"], "thesis_rate_per_min": THESIS_RATE,
                  "kill_line_rate_per_min": KILL_LINE_RATE,
-                 "limit": limit_text(best, cap, problem.min_hold)},
+                 "limit": best["limit"]},
         "baseline": {"hold_time_s": baseline.hold, "max_finger_force_N": baseline.peak,
                      "line_rate_per_min": base_rate,
                      "design": {v.name: v.baseline for v in space.variables}},
@@ -264,13 +267,18 @@ def _output(problem: DesignProblem, space: DesignSpace, population: Population,
                      artifacts={"baseline": baseline.run, "optimum": optimum})
 
 
-def limit_text(case: dict, cap: float, min_hold: float) -> str:
-    """What stops the case's rate rising: the bird nearest to a rule and the
-    rule (its hold against ``min_hold``, its peak against the cap)."""
-    birds = case["birds"]
-    short = min(birds, key=lambda b: b["hold_time_s"])
-    tight = max(birds, key=lambda b: b["max_finger_force_N"])
-    return (f"{short['bird']} is held {short['hold_time_s']:.4f} s against the "
-            f"{min_hold:g} s asked; {tight['bird']} presses finger "
-            f"{tight['max_finger_force_finger']} {tight['max_finger_force_N']:.2f} N against the "
-            f"{cap:.2f} N cap")
+def faster_limit(outcome, min_hold: float, space: DesignSpace) -> str:
+    """What keeps the search's answer from a higher rate: the rules broken
+    by the slowest faster design it simulated (the longest-held of those),
+    or the drum speed's bound, or the budget."""
+    answer = rate_of(outcome.best)
+    faster = [t.value for t in outcome.trials if rate_of(t.value) > answer * (1 + 1e-9)]
+    if not faster:
+        names = [v.name for v in space.variables]
+        if "drum_speed" in names and outcome.best.d[names.index("drum_speed")] >= 1.0:
+            return "the drum speed's upper bound"
+        return "no faster design was simulated within the search's budget"
+    nearest = min(faster, key=lambda v: (rate_of(v), -v.hold))
+    rules = broken(nearest, outcome.caps, min_hold) or ["none (a later step would keep them)"]
+    return (f"the nearest faster design simulated, {rate_of(nearest):.1f} birds/min, breaks: "
+            + "; ".join(rules))

@@ -26,7 +26,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from design.physics.grasper import Grasper
+from design.solvers.grasp.validity import finger_limits
 from design.solvers.optimize.trust_region import Scored, better
 
 #: the thesis's grasper and the kill line it feeds (birds per minute)
@@ -76,3 +79,29 @@ def _standing(scored: Scored, caps, min_hold: float) -> int:
     if not scored.within(caps):
         return 0
     return 2 if scored.holds.min() >= min_hold else 1
+
+
+def broken(scored: Scored, caps, min_hold: float) -> list[str]:
+    """The rules a simulated design breaks, bird by bird: a run that ended
+    early, a jam, a finger over the cap or its fold force, a hold shorter
+    than ``min_hold``."""
+    out = []
+    for member, evaluated, cap in zip(scored.population.members, scored.members,
+                                      np.broadcast_to(np.asarray(caps, float),
+                                                      (len(scored.members),))):
+        s, setup = evaluated.run.summary, evaluated.run.setup
+        if not s["ok"]:
+            out.append(f"{member.name}: its simulation ended early ({s['message']})")
+            continue
+        out += [f"{member.name}: {reason}" for reason in s["jam"]
+                if not reason.startswith("finger ")]
+        for gf, limit in zip(setup.grasper.fingers, finger_limits(setup, cap)):
+            force = s["max_force_per_finger_N"][gf.name]
+            if force > limit:
+                rule = "the cap" if limit == cap else "its fold force"
+                out.append(f"{member.name}: finger {gf.name} presses {force:.2f} N, over "
+                           f"{rule} {limit:.2f} N")
+        if evaluated.hold < min_hold:
+            out.append(f"{member.name}: held {evaluated.hold:.4f} s, under the "
+                       f"{min_hold:g} s asked")
+    return out

@@ -254,6 +254,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
                   "processes": pool.processes,
                   "processes_cpu_time_s": pool.children_cpu_time,
                   "caps_N": caps_value(caps)}
+    out.trials = found.trials
     out.wall_time = time.perf_counter() - t0
     return out
 

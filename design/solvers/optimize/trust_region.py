@@ -204,6 +204,9 @@ class Outcome:
     profile: Profile = field(default_factory=Profile)
     #: a pattern search's settings and count (None: the trust-region loop)
     search: dict | None = None
+    #: a pattern search's simulated designs, in order (each a Trial whose
+    #: value is the design scored without its trajectories)
+    trials: list = field(default_factory=list)
 
     @property
     def cap(self) -> float:
