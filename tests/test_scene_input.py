@@ -259,8 +259,8 @@ def test_design_variables_without_a_scene_are_checked_by_name(tmp_path, capsys):
     assert capsys.readouterr().err.splitlines() == [
         f"error: {path}: scene: required but missing",
         f"error: {path}: variables.3: no such design variable (allowed: fingers.<name>.<angle|"
-        f"phi_x|phi_y|length|height>, groups.<group>.stiffness_scale, conveyor.<start_time|rate|"
-        f"final_speed>, drum_speed, spacing)"]
+        f"phi_x|phi_y|length|height>, groups.<group>.stiffness_scale, conveyor.<speed|start_time|"
+        f"rate|final_speed>, drum_speed, spacing, bird_spacing)"]
 
 
 def test_an_overflowing_stiffness_profile_is_one_problem(tmp_path, capsys):
