@@ -329,6 +329,12 @@ def multistart(path: Path, data: dict) -> list[str]:
     return section("The main job from eight starts", "multistart", path, data, lines)
 
 
+def caps(cap_N: float | list[float]) -> str:
+    """'19.60 N for every finger' when one cap holds for all, else the range."""
+    low, high = (min(cap_N), max(cap_N)) if isinstance(cap_N, list) else (cap_N, cap_N)
+    return f"{low:.2f} N for every finger" if high == low else f"{low:.2f}-{high:.2f} N"
+
+
 def population(path: Path, data: dict) -> list[str]:
     p = data.get("population")
     if p is None:
@@ -341,8 +347,8 @@ def population(path: Path, data: dict) -> list[str]:
                         f"{words}: peak (N)": lambda r, k=key: r[f"{k}_max_finger_force_N"],
                         f"{words}: jam": lambda r, k=key: r[f"{k}_jam"]})
     lines = [f"`{p['command']}`: {p['status']} in {p['wall_time_s']:.0f} s on {p['workers']} "
-             f"workers ({p['simulations']} designs simulated for every bird), one cap "
-             f"{p['cap_N']:.2f} N for all: {p['message']}", "", "Each bird at 4x finer "
+             f"workers ({p['simulations']} designs simulated for every bird), caps "
+             f"{caps(p['cap_N'])}: {p['message']}", "", "Each bird at 4x finer "
              "resolution:", "", *table(p["birds"], columns)]
     return section("The flock: one design for Table 5-5's birds", "flock population", path, p,
                    lines)
@@ -353,9 +359,9 @@ def line_speed(path: Path, data: dict) -> list[str]:
     if q is None:
         return []
     lines = [f"`{q['command']}`: {q['status']} in {q['wall_time_s']:.0f} s on {q['workers']} "
-             f"workers: {q['message']}. The baseline (the thesis's design) runs "
-             f"{q['baseline_rate_per_min']:.0f} birds/min; every bird must be held "
-             f"{q['min_hold_s']:g} s under {q['cap_N']:.2f} N without a jam. What limits the "
+             f"workers: {q['message']} (the thesis's design, measured in the same run). Every "
+             f"bird must be held {q['min_hold_s']:g} s under {caps(q['cap_N'])} without a jam. "
+             "What limits the "
              f"answer: {q['limit']}.", "", *table(q["cases"], {
                  "finger sets": lambda r: r["finger_sets"], "status": lambda r: r["status"],
                  "rate (birds/min)": lambda r: r["line_rate_per_min"],
