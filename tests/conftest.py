@@ -28,6 +28,13 @@ if "numpy" in sys.modules:
                   "set OPENBLAS_NUM_THREADS=1 in the environment for the full speed")
 
 
+def pytest_collection_modifyitems(items):
+    """Tests marked ``both_cores`` (a browser's processes) run last: alone
+    on the machine once the prefetch worker is done, they take about half
+    the time they take beside it."""
+    items.sort(key=lambda item: item.get_closest_marker("both_cores") is not None)
+
+
 def pytest_collection_finish(session):
     """Start the prefetch worker (tests/prefetch.py) on the simulations and
     references the selected tests will ask for, in the order they will."""
@@ -47,13 +54,15 @@ def _prefetch_jobs(session) -> list:
     from tests.design_cases import (COMPILE, compile_finger_loads, prefetch_jobs,
                                     prefetched_simulation)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
+    from tests.test_design_solve import KKT, kkt_optimum
     from tests.test_fit_bench import MOULDED, moulded_fit
     from tests.test_grasp import HARD, HARD_FINE, hard_run
     from tests.test_peaks import RUNS, peak_runs
     from tests.test_population import TWINS, solve_twins
+    from tests.test_profile import PROFILED, solve_profiled
     from tests.test_reports import DESIGN_RUN, solve_short_design
     from tests.test_reproduce_command import QUICK, reproduce_quick
-    from tests.test_spatial_nlp import PLACED_HOLD, placed_hold
+    from tests.test_spatial_nlp import ON_THE_BELT, PLACED_HOLD, on_the_belt, placed_hold
     from tests.test_tradeoff import BEAM_STUDY, GRASP_WINDOW, beam_study, grasp_window_study
     from tests.test_validation import (FOOTBALL, MEAN_CONSTANT, MEAN_HARD, MEAN_SOFT,
                                        PLACED_HARD, THESIS_SOFT, football_run, mean_bird_run,
@@ -76,6 +85,11 @@ def _prefetch_jobs(session) -> list:
     simulations = prefetch_jobs()
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
+    if asked(["tests/test_design_solve.py::test_kkt"]):
+        # after the short grasp's baseline at the loop's tolerance, which it uses
+        jobs.append((KKT, kkt_optimum, (), (simulations[0][0],)))
+    if asked(["tests/test_profile.py::"]):
+        jobs.append((PROFILED, solve_profiled, (folder("profile"),), (simulations[0][0],)))
     if fixture_used("moulded_finger"):
         jobs.append((MOULDED, moulded_fit, (folder("moulded"),), ()))
     # tests/test_grasp.py's two runs, asked for before test_reports' design run
@@ -100,6 +114,8 @@ def _prefetch_jobs(session) -> list:
         jobs.append((GRASP_WINDOW, grasp_window_study, (), ()))
     if asked(["tests/test_spatial_nlp.py::test_the_nlp_calls_the_spatial_finger"]):
         jobs.append((PLACED_HOLD, placed_hold, (), ()))
+    if fixture_used("finger_5a_on_the_belt"):
+        jobs.append((ON_THE_BELT, on_the_belt, (), ()))
     if fixture_used("football"):
         jobs.append((FOOTBALL, football_run, (), ()))
     if fixture_used("mean_soft"):

@@ -28,7 +28,7 @@ def baseline():
 def test_rebound_nlp_solves_as_a_new_one(baseline):
     space, d0, run = baseline
     schedule = schedule_of(run, 0.01)
-    settings = NLPSettings(time_step=0.01, max_iter=8)
+    settings = NLPSettings(time_step=0.01, max_iter=3)
     wide = (np.clip(d0 - 0.2, 0, 1), np.clip(d0 + 0.2, 0, 1))
     narrow = (np.clip(d0 - 0.05, 0, 1), np.clip(d0 + 0.05, 0, 1))
     nlp = DesignNLP(space, schedule, run, 17.0, settings, box=wide)

@@ -15,19 +15,32 @@ from __future__ import annotations
 import html
 import json
 import time
+from pathlib import Path
 
 import pytest
 
 from design.cli import main
 from design.solvers.optimize.profile import (IPOPT, OPTIMISER, UNACCOUNTED, VIEWS, Profile,
                                            profile_rows)
+from tests import prefetch
 from tests.design_cases import LOOP, shared_simulate_grasp, short_problem_file, short_setup
+
+
+#: the prefetch worker's key for :func:`solve_profiled` (tests/prefetch.py)
+PROFILED = "tests/test_profile.py: the short design solve's result and report"
 
 
 @pytest.fixture(scope="module")
 def solved(tmp_path_factory):
-    """result.json and report.html of the short design solve."""
-    tmp = tmp_path_factory.mktemp("profile")
+    """result.json and report.html of the short design solve, run ahead by
+    the prefetch worker into the folder it was given, or here."""
+    given = prefetch.scheduled(PROFILED)
+    tmp = given[0] if given else tmp_path_factory.mktemp("profile")
+    return prefetch.result(PROFILED, solve_profiled, tmp)
+
+
+def solve_profiled(tmp: Path) -> tuple[dict, str]:
+    """The short design solve in ``tmp``: its result.json and report.html."""
     run = shared_simulate_grasp(short_setup(), LOOP.simulator)
     path = short_problem_file(tmp / "problem.yaml",
                               {"groups.upper.stiffness_scale": [0.5, 1.5]},

@@ -241,6 +241,7 @@ def _bird_pixels(png: bytes) -> np.ndarray:
     return np.column_stack([cols, rows])
 
 
+@pytest.mark.both_cores
 def test_the_report_plays_offline_and_draws_the_bird_where_the_time_series_puts_it(design_run):
     """The design report in headless Chromium: it loads with no console
     error and no request beyond its own file; stepped to three frames and

@@ -25,6 +25,7 @@ from tests import prefetch
 ROOT = Path(__file__).resolve().parents[1]
 #: the prefetch worker's key for :func:`placed_hold`
 PLACED_HOLD = "test_spatial_nlp: placed bird, 0.5 s"
+ON_THE_BELT = "test_spatial_nlp: placed bird, 0.245 s, at the design loop's tolerance"
 
 
 def placed_space(duration: float) -> DesignSpace:
@@ -170,15 +171,21 @@ def test_the_nlp_calls_the_spatial_finger_with_each_nodes_state(monkeypatch):
     assert forces.max() > 20.0                   # finger 4a holds the bird: real contacts
 
 
+def on_the_belt():
+    """The placed bird's spatial run to 0.245 s at the design loop's
+    tolerance (3 s CPU), with its setup: finger 5a's tip is on the belt."""
+    space = placed_space(0.245)
+    setup = space.setup(space.scale(space.base_values))
+    return setup, simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)
+
+
 @pytest.fixture(scope="module")
 def finger_5a_on_the_belt():
     """Finger 5a pressing the placed mean bird while its tip rests on the belt
     (the spatial run to 0.245 s, 3 s CPU: its last record has 5a in mode
     interior+belt at about 17 N), with its NLP function, interpreted."""
     from design.solvers.optimize.finger_load import FingerLoad
-    space = placed_space(0.245)
-    setup = space.setup(space.scale(space.base_values))
-    run = simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)
+    setup, run = prefetch.result(ON_THE_BELT, on_the_belt)
     i = [gf.name for gf in setup.grasper.fingers].index("5a")
     record = run.trajectory.records[-1]
     with pytest.MonkeyPatch.context() as patch:
