@@ -51,10 +51,9 @@ def _prefetch_jobs(session) -> list:
     """(key, function, arguments, needs) of what the selected tests will ask
     for, roughly in the order they will (the tests take over what the worker
     has not reached); what none of them asks for is left out."""
-    from tests.design_cases import (COMPILE, compile_finger_loads, prefetch_jobs,
-                                    prefetched_simulation)
+    from tests.design_cases import (COMPILE, SINGLE_BIRD, compile_finger_loads, prefetch_jobs,
+                                    prefetched_simulation, single_bird_optimum)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
-    from tests.test_design_solve import KKT, kkt_optimum
     from tests.test_fit_bench import MOULDED, moulded_fit
     from tests.test_grasp import HARD, HARD_FINE, hard_run
     from tests.test_peaks import RUNS, peak_runs
@@ -86,8 +85,9 @@ def _prefetch_jobs(session) -> list:
     jobs += [(key, prefetched_simulation, inputs, ()) for key, inputs, users in simulations
              if asked(users)]
     if asked(["tests/test_design_solve.py::test_kkt"]):
-        # after the short grasp's baseline at the loop's tolerance, which it uses
-        jobs.append((KKT, kkt_optimum, (), (simulations[0][0],)))
+        # after the short grasp's baseline at the loop's tolerance, which it
+        # uses; before the twins, which reuse it in the worker
+        jobs.append((SINGLE_BIRD, single_bird_optimum, (), (simulations[0][0],)))
     if asked(["tests/test_profile.py::"]):
         jobs.append((PROFILED, solve_profiled, (folder("profile"),), (simulations[0][0],)))
     if fixture_used("moulded_finger"):

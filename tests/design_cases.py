@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import itertools
 import json
 from dataclasses import replace
@@ -210,3 +211,34 @@ def sharing_simulations():
         for module in ("design.solvers.optimize.trust_region", "design.run.grasp"):
             patch.setattr(f"{module}.simulate_grasp", shared_simulate_grasp)
         yield
+
+
+#: the prefetch worker's key for :func:`single_bird_optimum` (tests/prefetch.py)
+SINGLE_BIRD = "tests/design_cases.py: both stiffness scales' optimum under 18.5 N"
+
+
+def single_bird_inputs():
+    """(space, schedule, loop run, box) of the design NLP of both stiffness
+    scales within 0.1 (scaled) of the baseline: with an 18.5 N cap, a box
+    where it converges (in about 20 iterations)."""
+    from design.solvers.optimize.schedule import schedule_of
+    from design.solvers.optimize.trust_region import simulate
+    space = stiffness_space("lower", "upper")
+    d0 = space.scale(space.base_values)
+    with sharing_simulations():
+        run = simulate(space, d0, LOOP).run
+    return space, schedule_of(run, 0.01), run, (np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1))
+
+
+def single_bird_nlp():
+    """:func:`single_bird_inputs`' NLP under an 18.5 N cap, the loop's settings."""
+    from design.solvers.optimize.transcription import DesignNLP
+    space, schedule, run, box = single_bird_inputs()
+    return DesignNLP(space, schedule, run, 18.5, LOOP.nlp, box=box)
+
+
+@functools.cache
+def single_bird_optimum():
+    """Ipopt's solution of :func:`single_bird_nlp` (6 s), once per process:
+    the KKT test checks it, the population's twins compare with it."""
+    return single_bird_nlp().solve()

@@ -21,7 +21,8 @@ from design.solvers.optimize.transcription import DesignNLP
 from design.solvers.optimize.trust_region import (Outcome, better, optimise, score, simulate,
                                                 verdict, verify)
 from tests import prefetch
-from tests.design_cases import LOOP, sharing_simulations, short_problem_file, stiffness_space
+from tests.design_cases import (LOOP, SINGLE_BIRD, sharing_simulations, short_problem_file,
+                                single_bird_nlp, single_bird_optimum, stiffness_space)
 
 
 @pytest.fixture
@@ -30,34 +31,15 @@ def shared_simulations():
         yield
 
 
-#: the prefetch worker's key for :func:`kkt_optimum` (tests/prefetch.py)
-KKT = "tests/test_design_solve.py: the KKT test's optimum"
-
-
-def kkt_nlp() -> DesignNLP:
-    """Both stiffness scales within 0.1 (scaled) of the baseline, cap 18.5 N."""
-    space = stiffness_space("lower", "upper")
-    d0 = space.scale(space.base_values)
-    with sharing_simulations():
-        run = simulate(space, d0, LOOP).run
-    return DesignNLP(space, schedule_of(run, 0.01), run, 18.5, LOOP.nlp,
-                     box=(np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1)))
-
-
-def kkt_optimum():
-    """Ipopt's solution of :func:`kkt_nlp` (6 s)."""
-    return kkt_nlp().solve()
-
-
 def test_kkt_conditions_hold_by_finite_differences():
     """Stationarity of the Lagrangian (Ipopt's multipliers, derivatives by
     central differences of the constraint functions, independent of CasADi's
     AD) and complementarity of every inequality, at a converged optimum with
     a bound active. The optimum may come from the prefetch worker: the
     differences are taken on this process's own NLP."""
-    nlp = kkt_nlp()
+    nlp = single_bird_nlp()
     space = nlp.space
-    r = prefetch.result(KKT, kkt_optimum)
+    r = prefetch.result(SINGLE_BIRD, single_bird_optimum)
     assert r.success, r.status
     assert r.peak_force <= 18.5 + 1e-6
     x, lam_g, lam_x = r.x, r.lam_g, r.lam_x

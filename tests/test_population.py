@@ -20,12 +20,12 @@ from design.io.scene import load_scene
 from design.errors import ProblemFileError
 from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
 from design.solvers.optimize.population import Member, Population, PopulationNLP
-from design.solvers.optimize.schedule import schedule_of
-from design.solvers.optimize.transcription import DesignNLP, NLPSettings
+from design.solvers.optimize.transcription import NLPSettings
 from design.run.solve import population_comparison
-from design.solvers.optimize.trust_region import simulate, verify
+from design.solvers.optimize.trust_region import verify
 from tests import prefetch
-from tests.design_cases import LOOP, sharing_simulations, stiffness_space
+from tests.design_cases import (LOOP, sharing_simulations, single_bird_inputs,
+                                single_bird_optimum, stiffness_space)
 
 NLP = NLPSettings(time_step=0.01, max_iter=60)
 
@@ -37,16 +37,11 @@ TWINS = "tests/test_population.py: the single bird's and the twins' NLPs"
 def solve_twins() -> dict:
     """The single bird's NLP and the NLP of two copies of it, solved, with
     the twins' size and the cap rows after a rebound to [15, 16] N."""
-    space = stiffness_space("lower", "upper")
-    d0 = space.scale(space.base_values)
-    with sharing_simulations():
-        run = simulate(space, d0, LOOP).run
-    # a cap and box where the single NLP converges (in 15 iterations): at
-    # tighter caps or wider boxes it stops at its iteration limit, and two
-    # unconverged solves need not agree
-    box = (np.clip(d0 - 0.1, 0, 1), np.clip(d0 + 0.1, 0, 1))
-    schedule = schedule_of(run, 0.01)
-    alone = DesignNLP(space, schedule, run, 18.5, NLP, box=box).solve()
+    # a cap and box where the single NLP converges: at tighter caps or wider
+    # boxes it stops at its iteration limit, and two unconverged solves need
+    # not agree
+    space, schedule, run, box = single_bird_inputs()
+    alone = single_bird_optimum()
     population = Population((Member("twin-a", space), Member("twin-b", space)))
     nlp = PopulationNLP(population, [schedule, schedule], [run, run], [18.5, 18.5], NLP,
                         box=box)
