@@ -12,7 +12,9 @@ problem's ``min_hold`` under the cap, against the thesis's 60 birds/min (the
 baseline design, measured in the same run), and the Pareto front.
 
 Each prints a table and writes its entry of benchmarks/results/flock.json
-(the other entry is kept), with the wall time and the number of workers.
+(the others are kept), with the wall time and the number of workers: on 2
+workers the study's entry, on any other number its own
+(``line_on_1_workers``), so that the page compares the wall times.
 
     python -m benchmarks.flock population [--workers 2]
     python -m benchmarks.flock line [--workers 2]
@@ -87,7 +89,8 @@ def main() -> None:
     print(f"\n{result['status']}: {result['message']}\n{wall:.1f} s on {args.workers} workers")
     kept = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     kept.pop("measured_at", None)
-    write_results(RESULTS, {**kept, args.study: {
+    key = args.study if args.workers == 2 else f"{args.study}_on_{args.workers}_workers"
+    write_results(RESULTS, {**kept, key: {
         "measured_at": datetime.now(timezone.utc).date().isoformat(),
         "machine": machine(load, at_end=True),
         "command": f"design solve {problem.relative_to(ROOT)} --workers {args.workers} "

@@ -372,8 +372,23 @@ def line_speed(path: Path, data: dict) -> list[str]:
                  "peak (N)": lambda r: r["max_finger_force_N"],
                  "wall (s)": lambda r: r["wall_time_s"]}),
              "", f"Pareto front (rate, worst hold, peak; jams excluded): {len(q['pareto'])} "
-             "designs."]
+             "designs.", *other_workers(data, "line", q)]
     return section("The line's rate for the flock", "flock line", path, q, lines)
+
+
+def other_workers(data: dict, study: str, reference: dict) -> list[str]:
+    """A sentence per run of ``study`` on another number of workers: its wall
+    time against the reference run's, and whether it gave the same answer."""
+    lines = []
+    for key in sorted(k for k in data if k.startswith(f"{study}_on_")):
+        run = data[key]
+        same = run["status"] == reference["status"] and run["message"] == reference["message"]
+        lines += ["", f"On {run['workers']} worker(s), measured {run['measured_at']}: "
+                  f"{run['status']} in {run['wall_time_s']:.0f} s "
+                  f"({run['wall_time_s'] / reference['wall_time_s']:.2f}x the "
+                  f"{reference['workers']} workers' time), "
+                  + ("the same answer." if same else f"another answer: {run['message']}.")]
+    return lines
 
 
 #: results file -> its sections' makers
