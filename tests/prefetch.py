@@ -2,9 +2,9 @@
 for, computed ahead in one worker process, on the machine's other core,
 while the tests before them run.
 
-The default run spends about a third of its time in a few simulations,
-references and one design solve that are known before the first test
-starts (tests/conftest.py lists them). The worker takes them in the order
+The default run spends about half of its time in simulations, references,
+NLP and design solves that are known before the first test starts
+(tests/conftest.py lists them). The worker takes them in the order
 the tests will need them and sends each result back whole (pickled: the
 same numbers, as the code and its inputs are the same; checked on the short
 grasp's runs, every record hashed). A test that asks for one the worker has

@@ -23,7 +23,7 @@ from design.solvers.optimize.variables import DesignSpace, parameters_of
 from tests import prefetch
 
 ROOT = Path(__file__).resolve().parents[1]
-#: the prefetch worker's key for :func:`placed_hold`
+#: the prefetch worker's keys for :func:`placed_hold` and :func:`on_the_belt`
 PLACED_HOLD = "test_spatial_nlp: placed bird, 0.5 s"
 ON_THE_BELT = "test_spatial_nlp: placed bird, 0.245 s, at the design loop's tolerance"
 
