@@ -26,11 +26,10 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 
 from design.physics.grasper import Grasper
 from design.solvers.grasp.validity import finger_limits
-from design.solvers.optimize.trust_region import Scored, better
+from design.solvers.optimize.trust_region import Scored, better, unmeasured_jams
 
 #: the thesis's grasper and the kill line it feeds (birds per minute)
 THESIS_RATE, KILL_LINE_RATE = 60.0, 180.0
@@ -86,15 +85,12 @@ def broken(scored: Scored, caps, min_hold: float) -> list[str]:
     early, a jam, a finger over the cap or its fold force, a hold shorter
     than ``min_hold``."""
     out = []
-    for member, evaluated, cap in zip(scored.population.members, scored.members,
-                                      np.broadcast_to(np.asarray(caps, float),
-                                                      (len(scored.members),))):
+    for member, (evaluated, cap) in zip(scored.population.members, scored.with_caps(caps)):
         s, setup = evaluated.run.summary, evaluated.run.setup
         if not s["ok"]:
             out.append(f"{member.name}: its simulation ended early ({s['message']})")
             continue
-        out += [f"{member.name}: {reason}" for reason in s["jam"]
-                if not reason.startswith("finger ")]
+        out += [f"{member.name}: {reason}" for reason in unmeasured_jams(s)]
         for gf, limit in zip(setup.grasper.fingers, finger_limits(setup, cap)):
             force = s["max_force_per_finger_N"][gf.name]
             if force > limit:

@@ -164,23 +164,33 @@ class Scored:
         of any finger of the other birds over its limit, as :meth:`excess`
         (-inf: no bird to judge)."""
         failed, jammed, worst = 0, 0, -np.inf
-        for m, cap in zip(self.members, np.broadcast_to(np.asarray(caps, float),
-                                                        (len(self.members),))):
+        for m, cap in self.with_caps(caps):
             s = m.run.summary
             if not s["ok"]:
                 failed += 1
                 continue
-            jammed += any(not reason.startswith("finger ") for reason in s["jam"])
+            jammed += bool(unmeasured_jams(s))
             limits = finger_limits(m.run.setup, cap)
             peaks = np.array([s["max_force_per_finger_N"][gf.name]
                               for gf in m.run.setup.grasper.fingers])
             worst = max(worst, float(np.max(peaks - limits * (1 + tolerance))))
         return failed, jammed, worst
 
+    def with_caps(self, caps):
+        """Each bird's evaluation with its cap (N; one number: every bird's)."""
+        return zip(self.members, np.broadcast_to(np.asarray(caps, float), (len(self.members),)))
+
     def within(self, caps, tolerance: float = 0.0) -> bool:
         """Does every bird stay under its cap (N) and every finger under its
         fold force, within ``tolerance`` (relative), with no bird jammed?"""
         return self.excess(caps, tolerance) <= 0.0
+
+
+def unmeasured_jams(summary: dict) -> list[str]:
+    """A run's jams that no finger force measures (a bird held to the end of
+    the run or not carried on); a finger past its fold force is judged by
+    its force against :func:`~design.solvers.grasp.validity.finger_limits`."""
+    return [reason for reason in summary["jam"] if not reason.startswith("finger ")]
 
 
 @dataclass
