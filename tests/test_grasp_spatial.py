@@ -1,8 +1,12 @@
 """The spatial finger model inside a grasp run (docs/MODEL.md, "spatial")."""
 
+from pathlib import Path
+
 import numpy as np
 
+from design.io.scene import load_scene
 from design.reproduce.grasp import MEAN_START, mean_bird_setup
+from design.run.grasp import setup_of
 from design.solvers.grasp.fingers import FingerForces
 
 
@@ -35,3 +39,40 @@ def test_the_loads_are_a_function_of_the_state():
     loads = np.array([committed.qx, committed.qz, committed.ty])
     np.testing.assert_allclose([trial.qx, trial.qz, trial.ty], loads,
                                atol=1e-9 * np.abs(loads).max())
+
+
+def test_a_commit_keeps_the_trial_solved_at_its_instant():
+    """An accepted instant's commit reuses the trial evaluated there (an
+    adaptive step's last stage), solving nothing again: its loads, forces,
+    finger shapes, out-of-plane shares and the states later evaluations
+    continue from are those of a commit that solves afresh, to the last bit
+    (the same computation from the same committed start), and so are the
+    next trial's loads. The main job's scene with the bird at X0 = -0.075 m:
+    finger 4a presses it (a bird-only contact), the three fingers 5 rest on
+    the belt."""
+    setup = setup_of(load_scene(Path(__file__).parents[1] / "problems" / "hold_time.yaml").scene)
+    b = setup.bird
+    y0 = np.array([MEAN_START, b.gamma + 0.002, 0.0, setup.conveyor.speed, 0.0, 0.0])
+    y1, y2 = (y0 + dt * np.concatenate([y0[3:], [0.0, 0.0, 0.0]]) for dt in (0.004, 0.008))
+    reused, fresh = (FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction,
+                                  model="spatial", intervals=6, belt=setup.belt,
+                                  belt_friction=setup.finger_belt_friction) for _ in range(2))
+    for f in (reused, fresh):
+        f.evaluate(0.0, y0, commit=True)
+    reused.evaluate(0.004, y1)
+    solves = reused.solves
+    kept, kept_states = reused.evaluate(0.004, y1, commit=True)
+    assert reused.solves == solves
+    solved, solved_states = fresh.evaluate(0.004, y1, commit=True)
+    kinds = {type(s.continued).__name__ for s in solved_states if s.solution is not None}
+    assert kinds == {"SpatialState", "Belted"} and max(s.magnitude for s in solved_states) > 5.0
+    assert (kept.qx, kept.qz, kept.ty) == (solved.qx, solved.qz, solved.ty)
+    for k, s in zip(kept_states, solved_states):
+        assert np.array_equal(k.force, s.force)
+        assert (k.normal_out_of_plane, k.sweep_out_of_plane) == \
+            (s.normal_out_of_plane, s.sweep_out_of_plane)
+        if s.solution is not None:
+            assert np.array_equal(k.solution.shape_points, s.solution.shape_points)
+            assert np.array_equal(k.continued.inverse, s.continued.inverse)
+    nxt = [f.evaluate(0.008, y2)[0] for f in (reused, fresh)]
+    assert (nxt[0].qx, nxt[0].qz, nxt[0].ty) == (nxt[1].qx, nxt[1].qz, nxt[1].ty)

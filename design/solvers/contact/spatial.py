@@ -24,7 +24,7 @@ friction against the finger's sliding, solved together with the contact.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import numpy as np
@@ -283,12 +283,31 @@ class SpatialContact:
             state, held, msg = self._settle(quadric, friction, previous)
             if state is None:
                 return no_spatial_contact(length, msg, converged=msg == GRAZES), None
-        sol = self._solution(state, msg, detail)
+        sol = self._solution(state, msg)
         sol.extras["friction_held"] = held
-        if detail:
-            state.inverse = self.tr[state.mode].chord.inverse(
-                state.z, self._params(state.quadric, state.friction))
-        return sol, state
+        return self.detailed(sol, state) if detail else (sol, state)
+
+    def detailed(self, sol: SpatialSolution, state: SpatialState
+                 ) -> tuple[SpatialSolution, SpatialState]:
+        """What an accepted instant keeps of a solve without detail: the
+        solution with the finger's shape (a finger that passes into the
+        object away from the contact is not converged), and the state with
+        its Jacobian inverse, to continue from by the chord method."""
+        tr = self.tr[state.mode]
+        q = self._params(state.quadric, state.friction)
+        post = state.post
+        point, arc = post[:3], float(post[4])
+        _, r, _ = (np.asarray(v) for v in tr.shape(state.z, q))
+        if arc < self.finger.length:
+            rest = np.linspace(0.0, self.finger.length - arc, 6)[1:]
+            r = np.hstack([r, point[:, None] + post[13:16, None] * rest[None, :]])
+        depth = -np.min(state.quadric.level(r) / (2 * np.sqrt(np.linalg.eigvalsh(
+            state.quadric.matrix).max())))
+        if depth > PENETRATION_TOL:
+            sol = replace(sol, converged=False, penetration=float(depth), message="; ".join(
+                m for m in (sol.message, f"the finger passes {depth:.3g} m into the object "
+                                         f"away from the contact") if m))
+        return replace(sol, shape_points=r), replace(state, inverse=tr.chord.inverse(state.z, q))
 
     def _chord(self, previous: SpatialState, quadric: Quadric, friction: np.ndarray
                ) -> SpatialState | None:
@@ -453,29 +472,14 @@ class SpatialContact:
         return "ok" if along <= 0 else "interior"
 
     # -------------------------------------------------------------- output
-    def _solution(self, state: SpatialState, msg: str, detail: bool) -> SpatialSolution:
+    def _solution(self, state: SpatialState, msg: str) -> SpatialSolution:
+        """The state as a :class:`SpatialSolution`, without the finger's shape
+        (:meth:`detailed` adds it)."""
         post = state.post
         point, normal_force, arc = post[:3], float(post[3]), float(post[4])
         normal, force_on_finger = post[7:10], post[10:13]
-        pts, penetration, converged = None, 0.0, True
-        if detail:
-            tr = self.tr[state.mode]
-            q = self._params(state.quadric, state.friction)
-            _, r, _ = (np.asarray(v) for v in tr.shape(state.z, q))
-            d1 = post[13:16]
-            if arc < self.finger.length:
-                rest = np.linspace(0.0, self.finger.length - arc, 6)[1:]
-                r = np.hstack([r, point[:, None] + d1[:, None] * rest[None, :]])
-            pts = r
-            depth = -np.min(state.quadric.level(r) / (2 * np.sqrt(np.linalg.eigvalsh(
-                state.quadric.matrix).max())))
-            if depth > PENETRATION_TOL:
-                penetration = float(depth)
-                converged = False
-                msg = "; ".join(m for m in (msg, f"the finger passes {penetration:.3g} m into "
-                                                 f"the object away from the contact") if m)
         return SpatialSolution(True, -force_on_finger, normal_force, point, normal, arc,
-                               state.mode == "tip", converged, msg, penetration, pts,
+                               state.mode == "tip", True, msg,
                                extras={"mode": state.mode, "friction": post[16:19].copy(),
                                        "z": state.z.copy(),
                                        "iterations": self.newton_iterations})

@@ -70,7 +70,17 @@ class SpatialBeltContact(BeltedContact):
         state, msg = self.continued(target, previous)
         if state is None:
             return self._failed(msg), None
-        return self._solution(state, msg, detail), self.with_inverse(state) if detail else state
+        sol = self._solution(state, msg)
+        return self.detailed(sol, state) if detail else (sol, state)
+
+    def detailed(self, sol: SpatialSolution, state: Belted) -> tuple[SpatialSolution, Belted]:
+        """What an accepted instant keeps of a solve without detail: the
+        solution with the finger's shape and how far it lies below the belt,
+        and the state with its Jacobian inverse (the chord method's)."""
+        pts = self._points(state)
+        return (replace(sol, shape_points=pts,
+                        below_belt=float(max(0.0, -state.plane.level(pts).min()))),
+                self.with_inverse(state))
 
     def adopt(self, state: SpatialState, plane: Plane, belt) -> Belted:
         """A bird-only state of :class:`SpatialContact` to continue here, with
@@ -262,15 +272,14 @@ class SpatialBeltContact(BeltedContact):
                                shape_points=np.vstack([np.linspace(0.0, self.length, 2),
                                                        np.zeros((2, 2))]))
 
-    def _solution(self, state: Belted, msg: str, detail: bool) -> SpatialSolution:
-        """The state as a :class:`SpatialSolution` with the belt's part."""
+    def _solution(self, state: Belted, msg: str) -> SpatialSolution:
+        """The state as a :class:`SpatialSolution` with the belt's part, without
+        the finger's shape (:meth:`detailed` adds it)."""
         if state.held < 1.0:
             msg = "; ".join(m for m in (msg, f"sticking: the finger carries {state.held:.0%} of "
                                              f"the sliding friction (no equilibrium beyond)") if m)
         mode, post = state.mode, state.post
-        pts = self._points(state) if detail else None
-        belt = {"below_belt": 0.0 if pts is None else
-                float(max(0.0, -state.plane.level(pts).min()))}
+        belt = {}
         if mode in BELT_MODES:
             belt.update(belt_force=-post[POST_BELT_ON_FINGER],
                         belt_normal_force=float(post[POST_BELT_FORCE]),
@@ -279,11 +288,11 @@ class SpatialBeltContact(BeltedContact):
                   "iterations": self.newton_iterations, "friction_held": state.held}
         if mode not in BIRD_MODES:
             return SpatialSolution(False, np.zeros(3), 0.0, None, None, 0.0, False, True, msg,
-                                   shape_points=pts, extras=extras, **belt)
+                                   extras=extras, **belt)
         extras["friction"] = post[16:19].copy()
         return SpatialSolution(True, -post[10:13], float(post[3]), post[:3].copy(),
                                post[7:10].copy(), float(post[4]), mode.startswith("tip"), True,
-                               msg, 0.0, pts, extras=extras, **belt)
+                               msg, extras=extras, **belt)
 
 
 # ------------------------------------------------------ rod state helpers

@@ -360,6 +360,13 @@ class SpatialFinger:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
 
+    def detailed(self, sol: SpatialSolution, state) -> tuple[SpatialSolution, object]:
+        """A trial's solve with the detail its commit adds (the finger's shape,
+        the continuation's Jacobian inverse): what :meth:`solve` with
+        ``commit`` returns from the same start at the same instant."""
+        solver = self.belted if isinstance(state, Belted) else self.solver
+        return solver.detailed(sol, state)
+
     def _law(self, kin_factory, quadric) -> FrictionLaw:
         """The bird's friction law in the finger frame: regularised Coulomb
         against the rigid finger's sliding over the bird's surface."""
@@ -444,6 +451,8 @@ class FingerForces:
         self.drum = grasper.drum(drum_speed)
         kind = FINGER_MODELS[model]
         self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
+        #: a commit may reuse the trial at its instant (:meth:`_commit_trial`)
+        self._trials_from_committed = kind.from_committed
         self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved
@@ -535,9 +544,13 @@ class FingerForces:
     def evaluate(self, t: float, y: np.ndarray, commit: bool = False
                  ) -> tuple[Loads, list[FingerState]]:
         key = (t, y.tobytes())
-        if not commit and key in self._memo:
-            return self._memo[key]
-        out = self._evaluate(t, y, commit)
+        trial = self._memo.get(key)
+        if not commit and trial is not None:
+            return trial
+        if commit and trial is not None and self._trials_from_committed:
+            out = self._commit_trial(t, y, trial)
+        else:
+            out = self._evaluate(t, y, commit)
         if commit:
             self._memo.clear()
             self._margins.clear()
@@ -577,7 +590,7 @@ class FingerForces:
             if commit:
                 self.states[i] = cont
             if p_w is None:
-                states.append(FingerState(solution=sol))
+                states.append(FingerState(solution=sol, continued=cont))
                 continue
             r = p_w - centre
             loads.qx += 2 * force[0]
@@ -585,6 +598,33 @@ class FingerForces:
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
             shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
             states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
+        return loads, states
+
+    def _commit_trial(self, t: float, y: np.ndarray, trial: tuple[Loads, list[FingerState]]
+                      ) -> tuple[Loads, list[FingerState]]:
+        """Commit the trial evaluation at (t, y): where every trial continues
+        from the committed contacts (``from_committed``), the trial solved
+        what the commit would, and the commit only adds each solve's detail
+        and each contact's out-of-plane shares. (An adaptive Runge-Kutta
+        step's last stage is evaluated where the step ends, the instant
+        then accepted.)"""
+        loads, trial_states = trial
+        body = self.ellipsoid(y)
+        states = []
+        for i, st in enumerate(trial_states):
+            if st.solution is None:                 # out of reach
+                self.trials[i] = self.states[i] = None
+                states.append(st)
+                continue
+            sol, cont = self.models[i].detailed(st.solution, st.continued)
+            if not sol.converged:
+                raise ContactFailed(t, self.grasper.fingers[i].name, sol.message)
+            self.trials[i] = self.states[i] = cont
+            if st.point is None:
+                states.append(FingerState(solution=sol, continued=cont))
+                continue
+            shares = self._shares(i, t, y, body, st.point)
+            states.append(FingerState(st.force, st.point, st.body_point, sol, *shares, cont))
         return loads, states
 
     def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
