@@ -28,6 +28,8 @@ from design.solvers.contact.spatial_belt_equations import (POST_BELT_FORCE, POST
 
 #: a quadric for the belt-only modes, which ignore the bird
 _NO_BIRD = Quadric(np.array([0.0, 0.0, 1.0]), np.eye(3))
+#: the states whose deepest point into the bird is kept
+DEEPEST_KEPT = 16
 
 
 class SpatialBeltContact(BeltedContact):
@@ -54,6 +56,7 @@ class SpatialBeltContact(BeltedContact):
         self.tr = {m: belt_transcription(contact.stiffness, rod.K, rod.d, m) for m in BELT_MODES}
         self.n_over = self.tr["interior+belt"].overhang.n_w
         self.tau, _, self.ends = legendre_tables(rod.d)[:3]
+        self._deepest_of: dict = {}
 
     # ----------------------------------------------------------------- API
     def solve(self, quadric: Quadric | None, friction, plane: Plane, belt,
@@ -218,9 +221,18 @@ class SpatialBeltContact(BeltedContact):
         return -level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
 
     def _deepest(self, state: Belted, quadric: Quadric) -> Deepest:
-        """Where a ``belt`` state's finger goes deepest into the bird."""
-        return deepest(self._points(state), self._tangents(state), quadric.center,
-                       quadric.matrix)
+        """Where a ``belt`` state's finger goes deepest into the bird (kept for
+        the last few states: a continuation step asks it of the same state
+        for its event, its clearance and its switch)."""
+        key = (state.mode, state.z.tobytes(), self.q(state).tobytes(),
+               None if state.post is None else state.post.tobytes(), quadric.params.tobytes())
+        found = self._deepest_of.get(key)
+        if found is None:
+            if len(self._deepest_of) >= DEEPEST_KEPT:
+                self._deepest_of.clear()
+            found = self._deepest_of[key] = deepest(self._points(state), self._tangents(state),
+                                                    quadric.center, quadric.matrix)
+        return found
 
     def _grazing(self, state: Belted) -> float | None:
         """Arc length (m) where the finger (free or on the belt) enters the
