@@ -13,7 +13,8 @@ at every knot of that span whether determined or not; the residual RMS
 over the stated noise, the model file's largest difference from the fit,
 and the run's wall time. Rows of the development benches (the ones the
 refinement was developed and tuned on) are marked and kept apart in the
-summary.
+summary. ``--markers N`` also fits every bench's x + y readings at N evenly
+spaced markers, to measure what more markers determine.
 
 ``--starts`` also measures where the refinement starts, on the x + y
 readings: from the uniform EI fitted on the elastica (what ``design fit``
@@ -22,7 +23,8 @@ path of weights.
 
 Prints tables and writes benchmarks/results/fit_bench.json.
 
-    python -m benchmarks.fit_bench              # 48 fits: ~7 minutes on the loaded 2 cores
+    python -m benchmarks.fit_bench              # 72 fits: ~10 minutes on 2 cores
+    python -m benchmarks.fit_bench --markers 8  # and 24 fits of 8 markers' x + y readings
     python -m benchmarks.fit_bench --starts
 """
 
@@ -47,15 +49,15 @@ from design.physics.beam import Finger
 from design.run.finger_fit import DETERMINED_BAND
 from design.run.fit import run
 from design.solvers.beam.collocation import Collocation
-from tests.fit_benches import (FAMILY, NOISE, READINGS, SECOND_BATCH, STEPPED, TUNING, readings,
-                               score, write_problem)
+from tests.fit_benches import (FAMILY, MARKERS, NOISE, READINGS, SECOND_BATCH, STEPPED,
+                               THIRD_BATCH, TUNING, readings, score, write_problem)
 
 RESULTS = Path(__file__).parent / "results" / "fit_bench.json"
 
 
-def fit_row(folder: Path, name: str, which: str) -> dict:
-    """One bench through the fit run, scored."""
-    problem = load_fit(write_problem(folder, name, which))
+def fit_row(folder: Path, name: str, which: str, markers: int = MARKERS) -> dict:
+    """One bench read at ``markers`` markers through the fit run, scored."""
+    problem = load_fit(write_problem(folder, name, which, markers))
     t0 = time.perf_counter()
     out = run(problem)
     wall = time.perf_counter() - t0
@@ -63,11 +65,12 @@ def fit_row(folder: Path, name: str, which: str) -> dict:
     p = r["profile"]
     profile = (np.asarray(p["s"]), np.asarray(p["EI"]), np.asarray(p["EI_low"], float),
                np.asarray(p["EI_high"], float))
-    sc = score(name, *profile, np.asarray(p["determined"]))
-    every = score(name, *profile, np.ones(len(p["s"]), dtype=bool))
-    _, _, slope = readings(name, which)
+    sc = score(name, *profile, np.asarray(p["determined"]), markers)
+    every = score(name, *profile, np.ones(len(p["s"]), dtype=bool), markers)
+    _, _, slope = readings(name, which, markers)
     el = r["elastica"] or {}
-    return {"bench": name, "readings": which, "tuning": name in TUNING, "set": batch(name),
+    return {"bench": name, "readings": which, "markers": markers, "tuning": name in TUNING,
+            "set": batch(name),
             "tip_slope_deg": float(np.degrees(slope)), "method": r["method"], "ok": r["ok"],
             "max_error": sc.max_error, "coverage": sc.coverage, "judged_knots": sc.judged,
             "judged_span_m": sc.span,
@@ -86,10 +89,12 @@ def fit_row(folder: Path, name: str, which: str) -> dict:
 
 
 def batch(name: str) -> str:
-    """The bench's set: development, held out, or the second held-out batch."""
+    """The bench's set: development, held out, or the second or third held-out batch."""
     if name in TUNING:
         return "development"
-    return "held out, second batch" if name in SECOND_BATCH else "held out"
+    if name in SECOND_BATCH:
+        return "held out, second batch"
+    return "held out, third batch" if name in THIRD_BATCH else "held out"
 
 
 def start_row(name: str, start: str) -> dict:
@@ -132,27 +137,32 @@ def main() -> None:
                         help="also compare the refinement's two starts on the x + y readings")
     parser.add_argument("--benches", nargs="+", choices=list(FAMILY), default=list(FAMILY),
                         help="a subset of the family (default: all)")
+    parser.add_argument("--markers", nargs="*", type=int, default=[], metavar="N",
+                        help=f"also fit the x + y readings of N evenly spaced markers "
+                             f"(the family reads {MARKERS})")
     args = parser.parse_args()
     load = [round(v, 2) for v in os.getloadavg()]
     rows = []
     print(f"{'':30s} {'determined span':^27s} {'every knot':^16s}")
-    print(f"{'bench':14s} {'readings':8s} {'slope':>6s} {'max EI error':>12s} {'coverage':>8s} "
+    print(f"{'bench':18s} {'readings':8s} {'slope':>6s} {'max EI error':>12s} {'coverage':>8s} "
           f"{'knots':>5s} {'max error':>9s} {'cover':>6s} {'RMS/noise':>14s} {'model':>6s} "
           f"{'time':>6s}")
+    runs = [(name, which, MARKERS) for name in args.benches for which in READINGS] + \
+        [(name, "x+y", n) for n in args.markers for name in args.benches]
     with tempfile.TemporaryDirectory() as tmp:
-        for name in args.benches:
-            for which in READINGS:
-                row = fit_row(Path(tmp), name, which)
-                rows.append(row)
-                rms = " ".join(f"{q} {v:.2f}" for q, v in row["rms_over_noise"].items())
-                print(f"{name + (' *' if row['tuning'] else ''):14s} {which:8s} "
-                      f"{row['tip_slope_deg']:5.1f}° {_pct(row['max_error']):>12s} "
-                      f"{row['coverage']:8.2f} {row['judged_knots']:5d} "
-                      f"{_pct(row['max_error_every_knot']):>9s} "
-                      f"{row['coverage_every_knot']:6.2f} {rms:>14s} "
-                      f"{row['model_gap_sigma']:6.2f} {row['wall_s']:5.1f}s"
-                      f"{'' if row['ok'] and row['method'] == 'elastica' else ' ' + row['method']}"
-                      f"{'' if row['ok'] else ' (not ok)'}", flush=True)
+        for name, which, markers in runs:
+            row = fit_row(Path(tmp), name, which, markers)
+            rows.append(row)
+            rms = " ".join(f"{q} {v:.2f}" for q, v in row["rms_over_noise"].items())
+            print(f"{name + (' *' if row['tuning'] else ''):18s} "
+                  f"{which + ('' if markers == MARKERS else f' {markers}m'):8s} "
+                  f"{row['tip_slope_deg']:5.1f}° {_pct(row['max_error']):>12s} "
+                  f"{row['coverage']:8.2f} {row['judged_knots']:5d} "
+                  f"{_pct(row['max_error_every_knot']):>9s} "
+                  f"{row['coverage_every_knot']:6.2f} {rms:>14s} "
+                  f"{row['model_gap_sigma']:6.2f} {row['wall_s']:5.1f}s"
+                  f"{'' if row['ok'] and row['method'] == 'elastica' else ' ' + row['method']}"
+                  f"{'' if row['ok'] else ' (not ok)'}", flush=True)
     print("* development bench (the refinement was developed and tuned on it); the others are "
           "held out")
     starts = []
@@ -169,8 +179,12 @@ def main() -> None:
                       f"{_pct(row['max_error']):>12s} {row['wall_s']:5.1f}s"
                       f"{'' if row['success'] else ' (failed)'}", flush=True)
     summary = {}
-    for label in ("development", "held out", "held out, second batch"):
-        subset = [r for r in rows if r["set"] == label]
+    sets = [(label, MARKERS) for label in ("development", "held out", "held out, second batch",
+                                           "held out, third batch")] + \
+        [(f"{n} markers, x + y", n) for n in args.markers]
+    for label, markers in sets:
+        subset = [r for r in rows if r["markers"] == markers
+                  and (r["set"] == label or markers != MARKERS)]
         smooth = [r for r in subset if r["bench"] not in STEPPED]
         summary[label] = {"fits": len(subset), "smooth_fits": len(smooth),
                           "smooth_meeting_targets": sum(r["meets_targets"] for r in smooth),
@@ -186,8 +200,8 @@ def main() -> None:
         "machine": machine(load),
         "benches": {n: {"length_m": b.length, "profile": b.what, "seed": b.seed,
                         "tuning": n in TUNING, "set": batch(n)} for n, b in FAMILY.items()},
-        "judged": "determined knots (band within ±25 %), 10 % of the length off each end, "
-                  "half a marker spacing off each step",
+        "judged": f"determined knots (band within ±{100 * DETERMINED_BAND:.0f} %), 10 % of the "
+                  f"length off each end, half a marker spacing off each step",
         "targets": "EI within 10 %, the band holding the truth at 90 % of the judged knots, "
                    "the judged span at least half the finger",
         "claims": "what the fit calls determined holds: no judged knot, or EI within 10 % "

@@ -236,6 +236,7 @@ def fit_bench(path: Path, data: dict) -> list[str]:
              "nothing is judged):", "", *table(data["rows"], {
                  "bench": lambda r: r["bench"], "set": lambda r: r["set"],
                  "readings": lambda r: r["readings"],
+                 "markers": lambda r: r["markers"],
                  "tip slope (deg)": lambda r: round(r["tip_slope_deg"]),
                  "judged share of the length": lambda r: round(r["judged_share"], 2),
                  "max EI error": lambda r: _share(r["max_error"]),

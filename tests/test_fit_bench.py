@@ -19,13 +19,17 @@ held to over the judged span (where the fit says EI is determined, less
 The tapers meet them all. On the other profiles (thickness falling as
 1 - k s², a sigmoid fall, steps, inserts, a rib) the band is wider than
 ±25 % at most knots, so little or nothing is claimed, and the tests ask
-that what is claimed holds; four fits of the second held-out batch do not
-(``OVER_CLAIMED``: the band holds the truth, but EI is off by up to 13 %).
+that what is claimed holds; nine fits of the held-out batches do not
+(``OVER_CLAIMED``): where ln EI bends over a few centimetres (a taper
+levelling off, a fall near the tip) EI is off by 10-13 % inside a band that
+holds the truth, and where the thickness falls fastest at the clamp
+(as (s/L)^0.7) EI is off by 10-11 % and the band misses the truth at a
+third to half of the knots.
 
 The default suite runs one fit, a moulded finger (taper-30) through the
-command's run, computed ahead by the prefetch worker (tests/prefetch.py); ``-m slow`` runs the whole family with each kind of reading (48
-fits, about five minutes), and benchmarks/fit_bench.py tabulates it with
-times.
+command's run, computed ahead by the prefetch worker (tests/prefetch.py);
+``-m slow`` runs the whole family with each kind of reading (72 fits,
+about ten minutes), and benchmarks/fit_bench.py tabulates it with times.
 """
 
 from __future__ import annotations
@@ -119,17 +123,18 @@ DETERMINED = ("uniform", "taper-10", "thickness-20", "taper-30", "thickness-50",
               "taper-50")
 
 
-#: fits of the second held-out batch whose determined span holds EI errors
-#: over 10 % (the band holds the truth; benchmarks/fit_bench.py): where ln EI
-#: bends over a few centimetres the smoothing rounds the bend off
-OVER_CLAIMED = {("sigmoid-wide-12", "x"), ("taper-flat-6", "x+y"), ("taper-flat-6", "x"),
-                ("taper-flat-6", "y")}
+#: held-out fits whose determined span holds EI errors over 10 % or a band
+#: that misses the truth at more than a tenth of its knots
+#: (benchmarks/fit_bench.py): the smoothing rounds off what the markers do not
+#: resolve, and the band does not cover that bias
+OVER_CLAIMED = {(name, which) for name in ("taper-flat-6", "thickness-0.7-25", "droop-10")
+                for which in READINGS}
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,which", [
     pytest.param(n, w, marks=pytest.mark.xfail(
-        strict=True, reason="EI errors of 11-13 % where it is called determined"))
+        strict=True, reason="EI errors of 10-13 % where it is called determined"))
     if (n, w) in OVER_CLAIMED else (n, w) for n in FAMILY for w in READINGS])
 def test_every_bench_fits_to_the_noise_and_claims_only_what_holds(name, which):
     """Every bench with each kind of reading: the fit converges, its

@@ -80,7 +80,9 @@ def _profile(page: Page, result: dict, artifacts: dict) -> None:
     """EI(s) with its band, the model file's, the reference, and which readings determine it."""
     problem = artifacts["problem"]
     page.section("Fitted EI(s)", "profile")
-    page.text("Which readings determine EI(s) (its band within ±25 % from them alone): "
+    band = f"±{100 * result['determined_band']:.0f} %"
+    page.text(f"Which readings determine EI(s) (its band within {band} from "
+              f"them alone): "
               + determination_text(result["determined_by"]) + ".")
     prof = result["profile"]
     s = np.asarray(prof["s"])
@@ -108,7 +110,7 @@ def _profile(page: Page, result: dict, artifacts: dict) -> None:
     ax.set_ylabel("EI (N m²)")
     ax.legend(fontsize=8)
     page.figure(fig, "ei_profile", "Fitted EI(s) with its 95 % band (grey: where the data "
-                "determine it, band within ±25 %)")
+                f"determine it, band within {band})")
 
 
 def determination_text(determined_by: dict) -> str:

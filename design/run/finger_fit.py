@@ -379,7 +379,7 @@ def finger_result(problem: FingerFitProblem, ff: FingerFit, summary: ProfileSumm
                     "EI_high": summary.high, "band_relative": summary.band,
                     "determined": summary.determined},
         "determined": _ranges(summary.knots, summary.determined), "reach": summary.reach,
-        "determined_by": determined_by(summary),
+        "determined_band": DETERMINED_BAND, "determined_by": determined_by(summary),
         "rms_residual": _rms_by_quantity(data, predictions),
         "noise_scale": fit.selection.noise_scale,
         "flagged": [{"line": data.observations[i].line,
