@@ -282,6 +282,26 @@ def test_a_bird_between_the_finger_s_nodes_is_touched():
         assert sol.arc_length == pytest.approx(LENGTH * 0.7, abs=0.02)
 
 
+def test_a_state_s_depth_into_the_bird_is_its_own_however_often_asked():
+    """A finger on the belt keeps the depth into the bird of the last states
+    it was asked about; a state with the same bird, belt and laws but
+    another shape (the finger's pressed 3 mm into the belt instead of
+    7.3 mm) gets its own depth, the one a new solver finds, and the first
+    state's is still its own when asked again."""
+    finger, _, spatial = solvers("thesis")
+    law = spatial_law(MU)
+    resting, shallow = (spatial.solve(None, FrictionLaw(), Plane(np.array([*NORMAL, 0.0]),
+                                                                 belt_offset(depth)), law)[1]
+                        for depth in (7.3e-3, 3e-3))
+    ball = Quadric(np.array([0.7 * LENGTH, 0.06, 0.0]), np.eye(3) / 0.05 ** 2)
+    near = replace(resting, bird=ball.params)
+    moved = replace(near, z=shallow.z)
+    fresh = SpatialBeltContact(SpatialContact(finger, intervals=8))
+    depths = [spatial.depth(s, "bird") for s in (near, moved, near)]
+    assert depths == [fresh.depth(s, "bird") for s in (near, moved, near)]
+    assert depths[0] != depths[1]
+
+
 def test_the_deepest_point_of_a_straight_finger_is_found_between_its_nodes():
     """A straight centreline with nodes at its ends and a circle of radius r
     dipping d below it at 40 % of its length: the lowest level ((r - d) / r)²

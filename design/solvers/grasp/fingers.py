@@ -564,7 +564,7 @@ class FingerForces:
         loads, states = Loads(), []
         centre = np.array([y[0], 0.0, y[1]])
         reaching = self.reaching(t, body)
-        for i, gf in enumerate(self.grasper.fingers):
+        for i in range(len(self.models)):
             force = None
             if i in reaching:
                 base, R = self.frame(i, t)
@@ -584,21 +584,29 @@ class FingerForces:
                 states.append(FingerState())
                 continue
             self.solves += 1
-            if not sol.converged:
-                raise ContactFailed(t, gf.name, sol.message)
-            self.trials[i] = cont
-            if commit:
-                self.states[i] = cont
+            states.append(self._kept(i, t, y, body, force, p_w, sol, cont, commit))
             if p_w is None:
-                states.append(FingerState(solution=sol, continued=cont))
                 continue
             r = p_w - centre
             loads.qx += 2 * force[0]
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
-            shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
-            states.append(FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont))
         return loads, states
+
+    def _kept(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, force: np.ndarray,
+              p_w: np.ndarray | None, sol, cont, commit: bool) -> FingerState:
+        """Finger i's solve at (t, y) as its state, kept to continue from (and
+        committed); a solve that did not converge raises :class:`ContactFailed`."""
+        if not sol.converged:
+            raise ContactFailed(t, self.grasper.fingers[i].name, sol.message)
+        self.trials[i] = cont
+        if commit:
+            self.states[i] = cont
+        if p_w is None:
+            return FingerState(solution=sol, continued=cont)
+        shares = self._shares(i, t, y, body, p_w) if commit else (np.nan, np.nan)
+        r = p_w - np.array([y[0], 0.0, y[1]])
+        return FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont)
 
     def _commit_trial(self, t: float, y: np.ndarray, trial: tuple[Loads, list[FingerState]]
                       ) -> tuple[Loads, list[FingerState]]:
@@ -617,14 +625,7 @@ class FingerForces:
                 states.append(st)
                 continue
             sol, cont = self.models[i].detailed(st.solution, st.continued)
-            if not sol.converged:
-                raise ContactFailed(t, self.grasper.fingers[i].name, sol.message)
-            self.trials[i] = self.states[i] = cont
-            if st.point is None:
-                states.append(FingerState(solution=sol, continued=cont))
-                continue
-            shares = self._shares(i, t, y, body, st.point)
-            states.append(FingerState(st.force, st.point, st.body_point, sol, *shares, cont))
+            states.append(self._kept(i, t, y, body, st.force, st.point, sol, cont, True))
         return loads, states
 
     def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
