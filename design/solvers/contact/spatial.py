@@ -191,13 +191,14 @@ def grazing_shift(quadric: Quadric, length: float, samples: int = 72
     """
     Q, c = quadric.matrix, quadric.center
     xs = np.linspace(0.0, length, 201)
+    # the finger's points relative to the centre, and their levels: the same for every v
+    d = np.stack([xs, np.zeros_like(xs), np.zeros_like(xs)]) - c[:, None]
+    c0 = np.einsum("in,ij,jn->n", d, Q, d) - 1.0
 
     def far_end(beta: float) -> tuple[float, float]:
         v = np.array([0.0, np.cos(beta), np.sin(beta)])
-        d = np.stack([xs, np.zeros_like(xs), np.zeros_like(xs)]) - c[:, None]
         a = v @ Q @ v
         b = v @ Q @ d
-        c0 = np.einsum("in,ij,jn->n", d, Q, d) - 1.0
         disc = b * b - a * c0
         ok = disc >= 0
         if not np.any(ok):
