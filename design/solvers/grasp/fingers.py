@@ -511,10 +511,10 @@ class FingerForces:
         axes, lengths = rotations[inside, :, 0], self._lengths[inside]
         out = set(inside[straight_level(body, bases[inside], axes, lengths) <= MISSES].tolist())
         tips = bases[inside] + axes * lengths[:, None]
-        depth = -tips[:, 2]
-        resting = (depth > 0) & np.array([self.belt.touches(self.grasper.fingers[i].design_name,
-                                                           tip[1]) for i, tip in zip(inside, tips)])
-        return out | set(inside[resting].tolist())
+        below = tips[:, 2] < 0
+        resting = [i for i, tip in zip(inside[below], tips[below])
+                   if self.belt.touches(self.grasper.fingers[i].design_name, tip[1])]
+        return out | set(int(i) for i in resting)
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the
