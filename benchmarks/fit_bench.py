@@ -49,8 +49,8 @@ from design.physics.beam import Finger
 from design.run.finger_fit import DETERMINED_BAND
 from design.run.fit import run
 from design.solvers.beam.collocation import Collocation
-from tests.fit_benches import (FAMILY, MARKERS, NOISE, READINGS, SECOND_BATCH, STEPPED,
-                               THIRD_BATCH, TUNING, readings, score, write_problem)
+from tests.fit_benches import (FAMILY, FOURTH_BATCH, MARKERS, NOISE, READINGS, SECOND_BATCH,
+                               STEPPED, THIRD_BATCH, TUNING, readings, score, write_problem)
 
 RESULTS = Path(__file__).parent / "results" / "fit_bench.json"
 
@@ -89,12 +89,12 @@ def fit_row(folder: Path, name: str, which: str, markers: int = MARKERS) -> dict
 
 
 def batch(name: str) -> str:
-    """The bench's set: development, held out, or the second or third held-out batch."""
+    """The bench's set: development, or the first to fourth held-out batch."""
     if name in TUNING:
         return "development"
-    if name in SECOND_BATCH:
-        return "held out, second batch"
-    return "held out, third batch" if name in THIRD_BATCH else "held out"
+    later = {"second": SECOND_BATCH, "third": THIRD_BATCH, "fourth": FOURTH_BATCH}
+    return next((f"held out, {n} batch" for n, names in later.items() if name in names),
+                "held out")
 
 
 def start_row(name: str, start: str) -> dict:
@@ -180,7 +180,7 @@ def main() -> None:
                       f"{'' if row['success'] else ' (failed)'}", flush=True)
     summary = {}
     sets = [(label, MARKERS) for label in ("development", "held out", "held out, second batch",
-                                           "held out, third batch")] + \
+                                           "held out, third batch", "held out, fourth batch")] + \
         [(f"{n} markers, x + y", n) for n in args.markers]
     for label, markers in sets:
         subset = [r for r in rows if r["markers"] == markers

@@ -54,7 +54,7 @@ def _prefetch_jobs(session) -> list:
     from tests.design_cases import (COMPILE, SINGLE_BIRD, compile_finger_loads, prefetch_jobs,
                                     prefetched_simulation, single_bird_optimum)
     from tests.test_contact_poses import REFERENCES, imposed_side_references
-    from tests.test_fit_bench import MOULDED, moulded_fit
+    from tests.test_fit_bench import CLAMP_TAPER, MOULDED, clamp_taper_fit, moulded_fit
     from tests.test_grasp import HARD, HARD_FINE, hard_run
     from tests.test_peaks import RUNS, peak_runs
     from tests.test_population import TWINS, solve_twins
@@ -92,6 +92,8 @@ def _prefetch_jobs(session) -> list:
         jobs.append((PROFILED, solve_profiled, (folder("profile"),), (simulations[0][0],)))
     if fixture_used("moulded_finger"):
         jobs.append((MOULDED, moulded_fit, (folder("moulded"),), ()))
+    if fixture_used("clamp_taper"):
+        jobs.append((CLAMP_TAPER, clamp_taper_fit, (folder("clamp_taper"),), ()))
     # tests/test_grasp.py's two runs, asked for before test_reports' design run
     if fixture_used("hard_fine"):
         jobs.append((HARD_FINE, hard_run, (4.0,), ()))

@@ -19,17 +19,19 @@ held to over the judged span (where the fit says EI is determined, less
 The tapers meet them all. On the other profiles (thickness falling as
 1 - k s², a sigmoid fall, steps, inserts, a rib) the band is wider than
 ±25 % at most knots, so little or nothing is claimed, and the tests ask
-that what is claimed holds; nine fits of the held-out batches do not
+that what is claimed holds; eleven fits of the held-out batches do not
 (``OVER_CLAIMED``): where ln EI bends over a few centimetres (a taper
-levelling off, a fall near the tip) EI is off by 10-13 % inside a band that
-holds the truth, and where the thickness falls fastest at the clamp
-(as (s/L)^0.7) EI is off by 10-11 % and the band misses the truth at a
-third to half of the knots.
+levelling off, a fall near the tip, a thickness falling as (s/L)^1.2 or
+(s/L)^0.7) EI is off by 10-13 % inside a band that holds the truth, and
+where EI falls twice, 3x and then 6x, x readings alone leave it off by 20 %
+with the band missing the truth at a sixth of the knots.
 
-The default suite runs one fit, a moulded finger (taper-30) through the
-command's run, computed ahead by the prefetch worker (tests/prefetch.py);
-``-m slow`` runs the whole family with each kind of reading (72 fits,
-about ten minutes), and benchmarks/fit_bench.py tabulates it with times.
+The default suite runs two fits through the command's run, computed ahead
+by the prefetch worker (tests/prefetch.py): a moulded finger (taper-30) and
+a strip thinning fastest at its clamp, whose GCV is least at the path's
+first weight; ``-m slow`` runs the whole family with each kind of reading
+(84 fits, about fifteen minutes), and benchmarks/fit_bench.py tabulates it
+with times.
 """
 
 from __future__ import annotations
@@ -107,6 +109,39 @@ def test_the_moulded_finger_is_fitted_from_noisy_readings(moulded_finger):
     assert result["model"]["max_difference_from_fit_sigma"] < 1.0
 
 
+#: the prefetch worker's key for :func:`clamp_taper_fit` (tests/prefetch.py)
+CLAMP_TAPER = "tests/test_fit_bench.py: the fit of a finger thinning fastest at its clamp"
+
+
+def clamp_taper_fit(folder: Path) -> dict:
+    """``design fit``'s run on the y readings of a strip whose thickness falls
+    as 1 - k (s/L)^0.7 (EI 25x from root to tip): the result."""
+    return run(load_fit(write_problem(folder, "thickness-0.7-25", "y"))).result
+
+
+@pytest.fixture(scope="module")
+def clamp_taper(tmp_path_factory):
+    """:func:`clamp_taper_fit`, run ahead by the prefetch worker or here."""
+    given = prefetch.scheduled(CLAMP_TAPER)
+    folder = given[0] if given else tmp_path_factory.mktemp("clamp_taper")
+    return prefetch.result(CLAMP_TAPER, clamp_taper_fit, folder)
+
+
+def test_a_fit_at_the_path_s_first_weight_has_a_band_for_what_gcv_cannot_rule_out(clamp_taper):
+    """EI falls fastest at the clamp, between the root and the first marker:
+    an exponential profile explains the readings within their noise, GCV is
+    least at the path's first weight, and that two-parameter fit is off by
+    up to 10 % near the clamp while its own band is a few per cent wide. The
+    band also covers the fits GCV cannot tell from it, so the module
+    docstring's targets hold: EI within 10 % where determined and the band
+    holding the truth at 90 % of those knots."""
+    el, p = clamp_taper["elastica"], clamp_taper["profile"]
+    assert el["chosen_solve"] == 0 and el["success"]
+    assert el["band_also_covers_weight"] < el["weight"]
+    assert_recovered("thickness-0.7-25", p["s"], p["EI"], p["EI_low"], p["EI_high"],
+                     p["determined"], clamp_taper["noise_scale"], clamp_taper["measurements"])
+
+
 @lru_cache(maxsize=None)
 def bench_fit(name: str, which: str):
     """``design fit``'s fit of a bench (no files written but the problem's):
@@ -127,14 +162,15 @@ DETERMINED = ("uniform", "taper-10", "thickness-20", "taper-30", "thickness-50",
 #: that misses the truth at more than a tenth of its knots
 #: (benchmarks/fit_bench.py): the smoothing rounds off what the markers do not
 #: resolve, and the band does not cover that bias
-OVER_CLAIMED = {(name, which) for name in ("taper-flat-6", "thickness-0.7-25", "droop-10")
-                for which in READINGS}
+OVER_CLAIMED = {(name, which) for name in ("taper-flat-6", "droop-10") for which in READINGS} \
+    | {("thickness-0.7-25", "x+y"), ("taper-double-18", "x"), ("taper-double-18", "y"),
+       ("thickness-1.2-35", "x+y"), ("thickness-1.2-35", "y")}
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,which", [
     pytest.param(n, w, marks=pytest.mark.xfail(
-        strict=True, reason="EI errors of 10-13 % where it is called determined"))
+        strict=True, reason="EI errors of 10-20 % where it is called determined"))
     if (n, w) in OVER_CLAIMED else (n, w) for n in FAMILY for w in READINGS])
 def test_every_bench_fits_to_the_noise_and_claims_only_what_holds(name, which):
     """Every bench with each kind of reading: the fit converges, its

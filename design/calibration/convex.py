@@ -96,6 +96,9 @@ class Selection:
     penalty: np.ndarray
     #: the band is taken at the chosen weight over this (1: at the chosen weight)
     band_undersmoothing: float = 1.0
+    #: another weight's fit the data cannot tell from the chosen one: the band
+    #: then also covers that fit and its own band (None: no other)
+    alternative: Selection | None = None
 
     @property
     def noise_scale(self) -> float:
@@ -105,13 +108,18 @@ class Selection:
 
     def z_sd(self, rows: np.ndarray | None = None) -> np.ndarray:
         """Standard deviations of the scaled unknowns (the band's, / 1.96), at
-        the chosen weight over :attr:`band_undersmoothing`; with ``rows``
-        (indices into the readings used), those the band would have were only
-        these readings taken (same weight, same noise scale)."""
+        the chosen weight over :attr:`band_undersmoothing`, widened where an
+        :attr:`alternative` fit (its distance / 1.96 plus its own) needs it;
+        with ``rows`` (indices into the readings used), those the band would
+        have were only these readings taken (same weights, same noise scales)."""
         A = self.design if rows is None else self.design[rows]
         weight = self.chosen.lam / self.band_undersmoothing
         cov = np.linalg.pinv(A.T @ A + weight * self.penalty.T @ self.penalty, hermitian=True)
-        return self.noise_scale * np.sqrt(np.clip(np.diag(cov), 0, None))
+        sd = self.noise_scale * np.sqrt(np.clip(np.diag(cov), 0, None))
+        if self.alternative is None:
+            return sd
+        gap = np.abs(self.alternative.chosen.z - self.chosen.z) / BAND_Z
+        return np.maximum(sd, gap + self.alternative.z_sd(rows))
 
     def studentised(self) -> np.ndarray:
         """r_i / (σ̂ sqrt(1 - H_ii)) of every measurement the fit used."""

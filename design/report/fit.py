@@ -69,7 +69,12 @@ def _method(page: Page, result: dict, fit) -> None:
                   f"built in {el['build_time_s']:.2f} s; weights from large to small, each "
                   f"solve starting from the last: {solves}. The path ended because "
                   f"{el['path_ended']}; weight {el['weight']:.4g} chosen by "
-                  f"{fit.selection.rule} on the elastica linearised at each solution.")
+                  f"{fit.selection.rule} on the elastica linearised at each solution."
+                  + ("" if el["band_also_covers_weight"] is None else
+                     f" It is the path's first, all but the best exponential profile, and "
+                     f"GCV cannot tell it from the fit at weight "
+                     f"{el['band_also_covers_weight']:.4g}: the band covers that fit and its "
+                     f"band too."))
     rms = ", ".join(f"{q}: {np.degrees(v):.3g} deg" if q == "psi" else f"{q}: {v * MM:.3g} mm"
                     for q, v in result["rms_residual"].items())
     page.text(f"Noise: the residuals are {fit.selection.noise_scale:.3g} times the stated "

@@ -416,7 +416,8 @@ def _elastica_result(ff: FingerFit) -> dict:
                         "iterations": s.iterations, "time_s": s.time_s} for s in ref.solves],
             "chosen_solve": ref.chosen, "path_ended": ref.ended,
             "weight": sel.chosen.lam, "noise_scale": sel.noise_scale,
-            "effective_parameters": sel.chosen.trace}
+            "effective_parameters": sel.chosen.trace,
+            "band_also_covers_weight": sel.alternative.chosen.lam if sel.alternative else None}
 
 
 def finger_tables(problem: FingerFitProblem, ff: FingerFit, summary: ProfileSummary,
