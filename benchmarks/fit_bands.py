@@ -7,7 +7,8 @@ under other rules, without fitting again:
 
 * the Bayesian band at the chosen weight over ``f`` (1: Wahba's band at the
   chosen weight; 10: the shipped rule, design/calibration/refinement.py's
-  BAND_UNDERSMOOTHING), optionally widened by an estimate of the smoothing's
+  BAND_UNDERSMOOTHING; where GCV is least at the path's first weight, widened
+  as shipped to cover the alternative fit), optionally widened by an estimate of the smoothing's
   bias, |ln c at the chosen weight - ln c k path steps smaller| (k = 2: a
   decade);
 * EI called determined where that band is within ±T.

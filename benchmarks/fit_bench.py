@@ -49,8 +49,9 @@ from design.physics.beam import Finger
 from design.run.finger_fit import DETERMINED_BAND
 from design.run.fit import run
 from design.solvers.beam.collocation import Collocation
-from tests.fit_benches import (FAMILY, FOURTH_BATCH, MARKERS, NOISE, READINGS, SECOND_BATCH,
-                               STEPPED, THIRD_BATCH, TUNING, readings, score, write_problem)
+from tests.fit_benches import (FAMILY, FIFTH_BATCH, FOURTH_BATCH, MARKERS, NOISE, READINGS,
+                               SECOND_BATCH, STEPPED, THIRD_BATCH, TUNING, readings, score,
+                               write_problem)
 
 RESULTS = Path(__file__).parent / "results" / "fit_bench.json"
 
@@ -89,10 +90,11 @@ def fit_row(folder: Path, name: str, which: str, markers: int = MARKERS) -> dict
 
 
 def batch(name: str) -> str:
-    """The bench's set: development, or the first to fourth held-out batch."""
+    """The bench's set: development, or the first to fifth held-out batch."""
     if name in TUNING:
         return "development"
-    later = {"second": SECOND_BATCH, "third": THIRD_BATCH, "fourth": FOURTH_BATCH}
+    later = {"second": SECOND_BATCH, "third": THIRD_BATCH, "fourth": FOURTH_BATCH,
+             "fifth": FIFTH_BATCH}
     return next((f"held out, {n} batch" for n, names in later.items() if name in names),
                 "held out")
 
@@ -180,7 +182,8 @@ def main() -> None:
                       f"{'' if row['success'] else ' (failed)'}", flush=True)
     summary = {}
     sets = [(label, MARKERS) for label in ("development", "held out", "held out, second batch",
-                                           "held out, third batch", "held out, fourth batch")] + \
+                                           "held out, third batch", "held out, fourth batch",
+                                           "held out, fifth batch")] + \
         [(f"{n} markers, x + y", n) for n in args.markers]
     for label, markers in sets:
         subset = [r for r in rows if r["markers"] == markers

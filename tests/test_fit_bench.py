@@ -19,18 +19,20 @@ held to over the judged span (where the fit says EI is determined, less
 The tapers meet them all. On the other profiles (thickness falling as
 1 - k s², a sigmoid fall, steps, inserts, a rib) the band is wider than
 ±25 % at most knots, so little or nothing is claimed, and the tests ask
-that what is claimed holds; eleven fits of the held-out batches do not
+that what is claimed holds; fourteen fits of the held-out batches do not
 (``OVER_CLAIMED``): where ln EI bends over a few centimetres (a taper
-levelling off, a fall near the tip, a thickness falling as (s/L)^1.2 or
-(s/L)^0.7) EI is off by 10-13 % inside a band that holds the truth, and
-where EI falls twice, 3x and then 6x, x readings alone leave it off by 20 %
-with the band missing the truth at a sixth of the knots.
+levelling off, a fall near the tip, a thickness falling as (s/L)^0.7,
+(s/L)^0.8 or (s/L)^1.2) EI is off by 10-13 % inside a band that holds the
+truth; where EI falls twice, 3x and then 6x, x readings alone leave it off
+by 20 % with the band missing the truth at a sixth of the knots; and a
+thickness falling as (s/L)^1.8, read for y alone, is off by 24 % inside a
+band of up to ±25 %.
 
 The default suite runs two fits through the command's run, computed ahead
 by the prefetch worker (tests/prefetch.py): a moulded finger (taper-30) and
 a strip thinning fastest at its clamp, whose GCV is least at the path's
 first weight; ``-m slow`` runs the whole family with each kind of reading
-(84 fits, about fifteen minutes), and benchmarks/fit_bench.py tabulates it
+(96 fits, about fifteen minutes), and benchmarks/fit_bench.py tabulates it
 with times.
 """
 
@@ -164,13 +166,14 @@ DETERMINED = ("uniform", "taper-10", "thickness-20", "taper-30", "thickness-50",
 #: resolve, and the band does not cover that bias
 OVER_CLAIMED = {(name, which) for name in ("taper-flat-6", "droop-10") for which in READINGS} \
     | {("thickness-0.7-25", "x+y"), ("taper-double-18", "x"), ("taper-double-18", "y"),
-       ("thickness-1.2-35", "x+y"), ("thickness-1.2-35", "y")}
+       ("thickness-1.2-35", "x+y"), ("thickness-1.2-35", "y"), ("thickness-0.8-40", "x+y"),
+       ("thickness-0.8-40", "y"), ("thickness-1.8-20", "y")}
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name,which", [
     pytest.param(n, w, marks=pytest.mark.xfail(
-        strict=True, reason="EI errors of 10-20 % where it is called determined"))
+        strict=True, reason="EI errors of 10-24 % where it is called determined"))
     if (n, w) in OVER_CLAIMED else (n, w) for n in FAMILY for w in READINGS])
 def test_every_bench_fits_to_the_noise_and_claims_only_what_holds(name, which):
     """Every bench with each kind of reading: the fit converges, its

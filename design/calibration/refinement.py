@@ -45,7 +45,7 @@ within :data:`SUPPORT` of the least (m ln(V / V_least) ≤ 2, about the
 difference in Akaike's criterion below which two models are taken as
 equally supported) and that fit's own band: ln c ± max(1.96 sd, |Δ ln c| +
 1.96 sd'). The rule was settled on the benches run before the fourth
-held-out batch and measured on that batch (benchmarks/fit_bench.py).
+held-out batch (tests/fit_benches.py, benchmarks/fit_bench.py).
 
 Where it starts: :func:`design.calibration.elastica.uniform_fit`, the uniform EI
 that fits the readings on the elastica. It needs no small-deflection fit (x
