@@ -142,8 +142,7 @@ def design_run(tmp_path_factory):
     from tests import prefetch
     from tests.test_reports import DESIGN_RUN, solve_short_design
 
-    given = prefetch.scheduled(DESIGN_RUN)
-    tmp = given[0] if given else tmp_path_factory.mktemp("design")
+    tmp = prefetch.folder(DESIGN_RUN, lambda: tmp_path_factory.mktemp("design"))
     status, checked = prefetch.result(DESIGN_RUN, solve_short_design, tmp)
     return status, tmp / "out", checked
 

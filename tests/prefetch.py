@@ -22,6 +22,7 @@ from __future__ import annotations
 import multiprocessing
 import os
 import queue
+from pathlib import Path
 from typing import Callable
 
 #: a job's state, shared with the worker
@@ -75,10 +76,11 @@ def stop() -> None:
     _pending.clear()
 
 
-def scheduled(key: str) -> tuple | None:
-    """The arguments the worker was given for ``key`` (None: not given it),
-    for a job whose arguments are made when it is scheduled (a folder)."""
-    return _jobs[key][1] if key in _jobs else None
+def folder(key: str, fresh: Callable[[], Path]) -> Path:
+    """The folder the worker was given for ``key`` (a job whose first
+    argument is a folder made when it is scheduled), or ``fresh()`` where it
+    was not given the job."""
+    return _jobs[key][1][0] if key in _jobs else fresh()
 
 
 def result(key: str, function: Callable, *args):

@@ -84,8 +84,7 @@ def moulded_fit(folder: Path) -> tuple[bool, dict, str]:
 def moulded_finger(tmp_path_factory):
     """:func:`moulded_fit`, run ahead by the prefetch worker into the folder
     it was given, or here."""
-    given = prefetch.scheduled(MOULDED)
-    folder = given[0] if given else tmp_path_factory.mktemp("moulded")
+    folder = prefetch.folder(MOULDED, lambda: tmp_path_factory.mktemp("moulded"))
     return prefetch.result(MOULDED, moulded_fit, folder)
 
 
@@ -124,8 +123,7 @@ def clamp_taper_fit(folder: Path) -> dict:
 @pytest.fixture(scope="module")
 def clamp_taper(tmp_path_factory):
     """:func:`clamp_taper_fit`, run ahead by the prefetch worker or here."""
-    given = prefetch.scheduled(CLAMP_TAPER)
-    folder = given[0] if given else tmp_path_factory.mktemp("clamp_taper")
+    folder = prefetch.folder(CLAMP_TAPER, lambda: tmp_path_factory.mktemp("clamp_taper"))
     return prefetch.result(CLAMP_TAPER, clamp_taper_fit, folder)
 
 

@@ -34,8 +34,7 @@ PROFILED = "tests/test_profile.py: the short design solve's result and report"
 def solved(tmp_path_factory):
     """result.json and report.html of the short design solve, run ahead by
     the prefetch worker into the folder it was given, or here."""
-    given = prefetch.scheduled(PROFILED)
-    tmp = given[0] if given else tmp_path_factory.mktemp("profile")
+    tmp = prefetch.folder(PROFILED, lambda: tmp_path_factory.mktemp("profile"))
     return prefetch.result(PROFILED, solve_profiled, tmp)
 
 

@@ -54,8 +54,7 @@ def reproduce_quick(out: Path) -> subprocess.CompletedProcess:
 def quick(tmp_path_factory):
     """One `design reproduce --quick` run: (folder, process); started ahead by
     the session's prefetch worker (tests/prefetch.py) when it runs."""
-    given = prefetch.scheduled(QUICK)
-    out = given[0] if given else tmp_path_factory.mktemp("reproduction")
+    out = prefetch.folder(QUICK, lambda: tmp_path_factory.mktemp("reproduction"))
     done = prefetch.result(QUICK, reproduce_quick, out)
     assert done.returncode == 0, done.stderr
     return out, done

@@ -51,8 +51,7 @@ def beam(tmp_path_factory):
     """One quick study of Table 2-3: exit code, output folder, tradeoff.json,
     stdout; run ahead by the session's prefetch worker (tests/prefetch.py)
     when it runs."""
-    given = prefetch.scheduled(BEAM_STUDY)
-    out = given[0] if given else tmp_path_factory.mktemp("tradeoff") / "out"
+    out = prefetch.folder(BEAM_STUDY, lambda: tmp_path_factory.mktemp("tradeoff") / "out")
     code, stdout = prefetch.result(BEAM_STUDY, beam_study, out)
     return code, out, json.loads((out / "tradeoff.json").read_text()), stdout
 
