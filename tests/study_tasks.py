@@ -18,8 +18,9 @@ from design.study import Case
 
 def value(calls: Path, case: Case, upstream: dict | None, *, kill: str | None = None,
           spare: int | None = None) -> dict:
-    """``hold_time_s`` = x / 100 plus the upstream's; ``chain`` lists the
-    keys up the chain. Raises for inputs ``fail``. The case keyed ``kill``
+    """``hold_time_s`` = x / 100 plus the upstream's (the sum of several
+    upstreams'); ``chain`` lists the keys up the chain (each upstream's in
+    turn). Raises for inputs ``fail``. The case keyed ``kill``
     kills its own process on its first attempt, 0.2 s after it is called
     (the cases finished before it are collected by then), unless the
     process is ``spare`` (the test's own)."""
@@ -31,7 +32,10 @@ def value(calls: Path, case: Case, upstream: dict | None, *, kill: str | None = 
         os.kill(os.getpid(), signal.SIGKILL)
     if case.inputs.get("fail"):
         raise ValueError(f"case {case.key} fails on purpose")
-    up = upstream or {"hold_time_s": 0.0, "chain": []}
+    ups = [] if upstream is None else [upstream] if "status" in upstream else \
+        list(upstream.values())
+    up = {"hold_time_s": sum(u["hold_time_s"] for u in ups),
+          "chain": [key for u in ups for key in u["chain"]]}
     return {"status": "verified", "verified": True,
             "hold_time_s": case.inputs["x"] / 100 + up["hold_time_s"],
             "max_finger_force_N": 10.0 * case.inputs["x"], "chain": up["chain"] + [case.key]}

@@ -22,11 +22,13 @@ ROOT = Path(__file__).resolve().parents[1]
 SERIAL = StudyOptions(workers=1)
 
 #: two chains given downstream first, a case on its own, a failing case and
-#: the chain after it
+#: the chain after it, a case that needs two and one that needs the failing one too
 CASES = [Case("b2", {"x": 4}, after="b1"), Case("b1", {"x": 3}, after="a"), Case("a", {"x": 1}),
          Case("c", {"x": 2}), Case("bad", {"x": 5, "fail": True}),
          Case("after-bad", {"x": 6}, after="bad"), Case("after-after-bad", {"x": 7},
-                                                         after="after-bad")]
+                                                         after="after-bad"),
+         Case("joined", {"x": 8}, after=("b2", "a")),
+         Case("after-c-and-bad", {"x": 9}, after=("c", "bad"))]
 
 
 def task(folder: Path):
@@ -62,6 +64,10 @@ def test_each_case_runs_after_the_case_it_needs_and_gets_its_result(tmp_path):
     assert results["b2"]["hold_time_s"] == pytest.approx(0.08)
     assert results["c"]["chain"] == ["c"]
     assert [c.key for c in ordered(CASES)][:3] == ["a", "b1", "b2"]
+    # a case that needs several gets each result, in the order it names them
+    assert results["joined"]["chain"] == ["a", "b1", "b2", "a", "joined"]
+    assert results["joined"]["hold_time_s"] == pytest.approx(0.08 + 0.01 + 0.08)
+    assert ordered(CASES).index(CASES[-2]) > max(ordered(CASES).index(c) for c in CASES[:3])
     here = f"{socket.gethostname()}:{os.getpid()}"
     assert {r["worker"] for k, r in results.items() if not k.startswith("after-")} == {here}
     assert all(r["wall_time_s"] >= 0.005 for k, r in results.items() if not k.startswith("after-"))
@@ -78,7 +84,10 @@ def test_a_failed_case_is_recorded_and_the_cases_after_it_skipped(tmp_path, caps
     assert results["after-after-bad"]["status"] == "skipped"
     assert "'after-bad'" in results["after-after-bad"]["message"]
     assert "after-bad" not in called(calls) and "after-after-bad" not in called(calls)
-    assert all(results[k]["status"] == "verified" for k in ("a", "b1", "b2", "c"))
+    assert results["after-c-and-bad"]["status"] == "skipped"
+    assert "'bad'" in results["after-c-and-bad"]["message"]
+    assert "after-c-and-bad" not in called(calls)
+    assert all(results[k]["status"] == "verified" for k in ("a", "b1", "b2", "c", "joined"))
     err = capsys.readouterr().err
     assert err.count("Traceback") == 1 and "fails on purpose" in err
     assert not any("Traceback" in str(r) for r in results.values())
@@ -90,6 +99,9 @@ def test_a_failed_case_is_recorded_and_the_cases_after_it_skipped(tmp_path, caps
 @pytest.mark.parametrize("cases, named", [
     ([Case("a", {}, after="nobody")], "'a'"),
     ([Case("a", {}, after="b"), Case("b", {}, after="a")], "cycle"),
+    ([Case("a", {}, after=("c", "b")), Case("b", {}, after="a"), Case("c", {})],
+     "cycle: a -> b -> a"),
+    ([Case("a", {}, after=("b", "nobody")), Case("b", {})], "'nobody'"),
     ([Case("a", {}), Case("a", {})], "'a' is given twice"),
     ([Case("a", {"x": object()})], "'a': inputs are not JSON"),
 ])
@@ -123,7 +135,8 @@ def test_a_stopped_study_resumes_with_only_the_cases_left(tmp_path):
     again, calls_again = task(tmp_path / "resumed")
     resumed = run_study(CASES, again, options=StudyOptions(workers=1, store=store, resume=True),
                         label="t")
-    assert called(calls_again) == ["bad", "c"]      # the rest; bad's downstream are skipped
+    # the rest; bad's downstream are skipped
+    assert called(calls_again) == ["bad", "c", "joined"]
     whole = run_study(CASES, task(tmp_path / "whole")[0], options=SERIAL, label="t")
     assert stripped(resumed) == stripped(whole)
     assert len(read_cases(store)) == len(CASES)
@@ -148,8 +161,10 @@ def test_resume_runs_again_failed_cases_and_those_whose_inputs_changed(tmp_path)
     fn, calls = task(tmp_path / "second")
     results = run_study(changed, fn, options=StudyOptions(workers=1, store=store, resume=True),
                         label="t")
-    # b1's inputs changed, so b2, which warm-starts from it, is not reused either
-    assert called(calls) == sorted(["b1", "b2", "bad", "after-bad", "after-after-bad"])
+    # b1's inputs changed, so b2, which warm-starts from it, is not reused
+    # either, nor joined, which needs b2
+    assert called(calls) == sorted(["b1", "b2", "bad", "after-bad", "after-after-bad",
+                                    "joined", "after-c-and-bad"])
     assert results["b2"]["hold_time_s"] == pytest.approx(0.14)
     assert results["after-after-bad"]["status"] == "verified"
 

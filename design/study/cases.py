@@ -23,12 +23,44 @@ class Case:
     (e.g. ``"start-03/cap-45.33N"``); ``inputs`` is everything that defines
     it, JSON-serialisable (stored with its result; a stored result is reused
     only for the same inputs); ``after`` is the key of the case whose result
-    this one needs (a warm-start chain), or None.
+    this one needs (a warm-start chain), a tuple of keys (it needs each of
+    their results), or None.
     """
 
     key: str
     inputs: dict
-    after: str | None = None
+    after: str | tuple[str, ...] | None = None
+
+    @property
+    def needs(self) -> tuple[str, ...]:
+        """The keys of the cases this one needs, in order."""
+        return () if self.after is None else \
+            (self.after,) if isinstance(self.after, str) else tuple(self.after)
+
+    @property
+    def after_text(self) -> str | None:
+        """``after`` as the case store keeps it: the key, or a JSON list of keys."""
+        return self.after if self.after is None or isinstance(self.after, str) else \
+            json.dumps(list(self.after))
+
+    def upstream(self, done: dict[str, dict]) -> dict | None:
+        """What the task gets from ``done`` (results by key): the needed
+        case's result, ``{key: result}`` for several, None without any
+        (or a result that is not in ``done``)."""
+        if isinstance(self.after, str):
+            return done.get(self.after)
+        if self.after is None or any(k not in done for k in self.after):
+            return None
+        return {k: done[k] for k in self.after}
+
+    def failed_upstream(self, done: dict[str, dict]) -> tuple[str, str] | None:
+        """The first needed case that did not finish (missing: ``error``) and
+        its status, or None."""
+        for k in self.needs:
+            status = done[k]["status"] if k in done else "error"
+            if status in FAILED:
+                return k, status
+        return None
 
 
 @dataclass(frozen=True)
@@ -82,23 +114,28 @@ def ordered(cases: list[Case]) -> list[Case]:
             raise ValueError(f"case {case.key!r}: inputs are not JSON: {exc}") from None
         by_key[case.key] = case
     for case in cases:
-        if case.after is not None and case.after not in by_key:
-            raise ValueError(f"case {case.key!r}: after {case.after!r}, which is no case "
-                             f"of the study")
+        for need in case.needs:
+            if need not in by_key:
+                raise ValueError(f"case {case.key!r}: after {need!r}, which is no case "
+                                 f"of the study")
     out: list[Case] = []
     placed: set[str] = set()
+
+    def place(case: Case, path: list[str]) -> None:
+        """``case`` after every case it needs (depth first); ``path``: the
+        cases waiting for it, to name a cycle."""
+        if case.key in placed:
+            return
+        if case.key in path:
+            raise ValueError(f"case {case.key!r}: its 'after' chain is a cycle: "
+                             + " -> ".join(path[path.index(case.key):] + [case.key]))
+        for need in case.needs:
+            place(by_key[need], path + [case.key])
+        out.append(case)
+        placed.add(case.key)
+
     for case in cases:
-        chain: list[Case] = []              # case, the case it needs, ..., up to a placed one
-        while case is not None and case.key not in placed:
-            keys = [c.key for c in chain]
-            if case.key in keys:
-                raise ValueError(f"case {case.key!r}: its 'after' chain is a cycle: "
-                                 + " -> ".join(keys[keys.index(case.key):] + [case.key]))
-            chain.append(case)
-            case = by_key[case.after] if case.after is not None else None
-        for link in reversed(chain):
-            out.append(link)
-            placed.add(link.key)
+        place(case, [])
     return out
 
 

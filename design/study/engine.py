@@ -2,7 +2,8 @@
 Dask workers, each finished case stored as it finishes (design/study/store.py).
 
 A task is ``task(case, upstream) -> dict``: ``upstream`` is the result of
-the case named by ``case.after`` (None without one). The result holds
+the case named by ``case.after``, ``{key: result}`` when it names several
+(None without one). The result holds
 ``"status"`` (a string) and may hold ``"hold_time_s"`` (a verified hold, s)
 and ``"verified"`` (bool), which the progress line and summary show. The
 engine adds ``"wall_time_s"`` (the task's wall time on its worker, s) and
@@ -126,7 +127,7 @@ def _run_serial(todo: list[Case], task: Task, done: dict[str, dict],
                 finish: Callable[[Case, dict], None]) -> None:
     for case in todo:
         interrupt.checkpoint(f"before study case {case.key!r}")
-        finish(case, _attempt(task, case, done.get(case.after) if case.after else None))
+        finish(case, _attempt(task, case, case.upstream(done)))
 
 
 def _run_dask(todo: list[Case], task: Task, options: StudyOptions, done: dict[str, dict],
@@ -143,8 +144,9 @@ def _run_dask(todo: list[Case], task: Task, options: StudyOptions, done: dict[st
         started(where)
         submitted, cases = {}, {}
         for case in todo:
-            upstream = submitted.get(case.after, done.get(case.after)) if case.after else None
-            future = client.submit(_attempt, task, case, upstream, pure=False)
+            # futures (inside a dict too) reach the task as their results
+            upstream = {k: submitted.get(k, done.get(k)) for k in case.needs}
+            future = client.submit(_attempt, task, case, case.upstream(upstream), pure=False)
             submitted[case.key], cases[future.key] = future, case
         running = as_completed(list(submitted.values()))
         del submitted, future
@@ -167,9 +169,9 @@ def _collected(future, case: Case, done: dict[str, dict]) -> dict:
     too often, or the case it needs failed so) as an error or skipped case."""
     if future.status == "finished":
         return future.result()
-    upstream = done.get(case.after) if case.after else None
-    if case.after is not None and (upstream is None or upstream["status"] in FAILED):
-        return _skipped(case, upstream["status"] if upstream else "error")
+    failed = case.failed_upstream(done)
+    if failed is not None:
+        return _skipped(*failed)
     exc = future.exception()
     return {"status": "error", "message": f"{type(exc).__name__}: {exc}",
             "wall_time_s": None, "worker": None}
@@ -177,9 +179,12 @@ def _collected(future, case: Case, done: dict[str, dict]) -> dict:
 
 def _attempt(task: Task, case: Case, upstream: dict | None) -> dict:
     """Run one case where it is scheduled: its result, JSON round-tripped,
-    with the wall time and worker; an exception becomes an error result."""
-    if upstream is not None and upstream["status"] in FAILED:
-        return _skipped(case, upstream["status"])
+    with the wall time and worker; an exception becomes an error result,
+    and a case whose needed case did not finish is skipped."""
+    failed = case.failed_upstream({case.after: upstream} if isinstance(case.after, str)
+                                  else upstream or {})
+    if failed is not None:
+        return _skipped(*failed)
     t0 = time.perf_counter()
     try:
         result = json.loads(json.dumps(jsonable(task(case, upstream)), allow_nan=False))
@@ -194,6 +199,6 @@ def _attempt(task: Task, case: Case, upstream: dict | None) -> dict:
     return result
 
 
-def _skipped(case: Case, upstream_status: str) -> dict:
-    return {"status": "skipped", "message": f"not run: the case it needs, {case.after!r}, "
+def _skipped(need: str, upstream_status: str) -> dict:
+    return {"status": "skipped", "message": f"not run: the case it needs, {need!r}, "
             f"ended {upstream_status}", "wall_time_s": 0.0, "worker": None}

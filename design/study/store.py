@@ -13,7 +13,7 @@ writes)::
           completed_at TEXT)     -- UTC, when every case finished without error; NULL before
     cases(key TEXT PRIMARY KEY,
           inputs TEXT,           -- the case's inputs, canonical JSON
-          after TEXT,            -- the key of the case it warm-starts from, or NULL
+          after TEXT,            -- the key of the case it needs, a JSON list of keys, or NULL
           result TEXT,           -- the result, JSON (with wall_time_s and worker)
           status TEXT,           -- result["status"]
           wall_time_s REAL,      -- the task's wall time (s), on its worker
@@ -74,8 +74,8 @@ class CaseStore:
         reused: dict[str, dict] = {}
         for case in cases:
             inputs, after, result = stored.get(case.key, (None, None, None))
-            if inputs == canonical(case.inputs) and after == case.after and \
-                    (case.after is None or case.after in reused):
+            if inputs == canonical(case.inputs) and after == case.after_text and \
+                    all(need in reused for need in case.needs):
                 reused[case.key] = result
         return reused
 
@@ -83,7 +83,7 @@ class CaseStore:
         """Store a finished case (replacing an earlier attempt's), committed at once."""
         with self._db:
             self._db.execute("INSERT OR REPLACE INTO cases VALUES (?, ?, ?, ?, ?, ?, ?, ?)",
-                             (case.key, canonical(case.inputs), case.after, canonical(result),
+                             (case.key, canonical(case.inputs), case.after_text, canonical(result),
                               result["status"], result.get("wall_time_s"),
                               result.get("worker"), utc_now()))
 
