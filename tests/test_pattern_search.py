@@ -137,3 +137,23 @@ def test_a_baseline_whose_simulation_ended_early_is_refused_naming_the_bird():
         check_baseline(birds, ran)
     ran.members[1].run.summary["ok"] = True
     check_baseline(birds, ran)
+
+
+def test_the_search_ends_at_the_first_step_whose_value_is_enough():
+    """A feasibility screen asks for a good enough design, not the best: the
+    search stops at the first step taken whose value is enough (no lattice
+    optimum claimed), and at once where the start is enough."""
+    d0 = np.full(4, 0.5)
+    whole = run(d0)
+    level = -0.05
+    assert quadratic(d0) < level < whole.value
+    found = run(d0, enough=lambda v: v >= level)
+    taken = [t for t in found.trials if t.taken]
+    assert found.value >= level and not found.lattice_optimum
+    # nothing simulated after that step but its extension pair's other point
+    last = next(n for n, t in enumerate(found.trials) if t is taken[-1])
+    assert taken[-1].value == found.value and last >= len(found.trials) - 2
+    assert all(t.value < level for t in taken[:-1])
+    assert len(found.trials) < len(whole.trials)
+    at_once = run(d0, enough=lambda v: True)
+    assert at_once.trials == [] and np.array_equal(at_once.d, d0)

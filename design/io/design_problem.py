@@ -15,6 +15,9 @@ bounds, the bruise cap, the design rules and the solver settings.
     population:                # optional: one design for several birds (robust design)
       objective: worst         # worst (the shortest hold) | mean (weighted by ``weight``)
       birds: [models/birds/small_1_20kg.yaml, {bird: models/birds/large_2_30kg.yaml, weight: 2}]
+      screen: {starts: 4, max_simulations: 16}   # where the baseline breaks a bird's limits:
+                               # the pattern search on the hardest bird alone from each start
+                               # (design/solvers/optimize/feasibility.py); the defaults
     multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
     model_check: spatial       # the default: baseline and optimum also run with the spatial
                                # finger (design/solvers/optimize/model_check.py); none: not
@@ -52,6 +55,7 @@ from design.solvers.optimize.finger_load import STAGE_MODELS
 from design.solvers.optimize.line import max_sets
 from design.solvers.optimize.model_check import CHECK_MODEL
 from design.solvers.optimize.policy import LOOP_METHODS, SOLVER_KEYS, loop_settings
+from design.solvers.optimize.feasibility import SIMULATIONS, STARTS
 from design.solvers.optimize.population import AGGREGATES
 from design.solvers.optimize.transcription import Rules
 from design.solvers.optimize.trust_region import LoopSettings
@@ -95,6 +99,10 @@ class PopulationSpec:
     birds: tuple[Bird, ...]
     weights: tuple[float, ...]
     objective: str = "worst"
+    #: the feasibility screen (design/solvers/optimize/feasibility.py): its
+    #: starts and each start's budget of simulations
+    screen_starts: int = STARTS
+    screen_simulations: int = SIMULATIONS
 
 
 @dataclass(frozen=True)
@@ -341,10 +349,19 @@ def _caps(reader: Reader, value: object) -> list[Cap] | None:
 
 
 def _population(reader: Reader, value: object, base_dir: Path) -> PopulationSpec | None:
-    spec = reader.mapping(value, "population", required=("birds",), optional=("objective",))
+    spec = reader.mapping(value, "population", required=("birds",),
+                          optional=("objective", "screen"))
     if spec is None:
         return None
     objective = reader.choice(spec, "objective", "population", AGGREGATES, default="worst")
+    screen = reader.mapping(spec.get("screen", {}), "population.screen",
+                            optional=("starts", "max_simulations"))
+    starts = simulations = None
+    if screen is not None:
+        starts = reader.integer(screen, "starts", "population.screen", lo=1, hi=1024,
+                                default=STARTS)
+        simulations = reader.integer(screen, "max_simulations", "population.screen", lo=1,
+                                     hi=10000, default=SIMULATIONS)
     items = spec["birds"]
     if not isinstance(items, list) or not items:
         reader.add("population.birds", "expected a non-empty list of birds (model files or "
@@ -369,9 +386,9 @@ def _population(reader: Reader, value: object, base_dir: Path) -> PopulationSpec
     for name in {n for n in names if names.count(n) > 1}:
         reader.add("population.birds", f"the bird '{name}' is listed twice: each bird once, "
                    "with a weight for its share")
-    if objective is None or len(birds) != len(items):
+    if None in (objective, starts, simulations) or len(birds) != len(items):
         return None
-    return PopulationSpec(tuple(birds), tuple(weights), objective)
+    return PopulationSpec(tuple(birds), tuple(weights), objective, starts, simulations)
 
 
 def _multistart(reader: Reader, value: object) -> MultistartSpec | None:

@@ -40,6 +40,7 @@ from design.solvers.optimize.robustness import robustness_text
 from design.solvers.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
+from design.solvers.optimize.feasibility import hardest_bird, screen, unreached
 from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solvers.optimize.pattern_search import search
@@ -134,7 +135,7 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     # one cap in newtons for every bird: ``baseline`` is the design bird's own peak
     reference = design_bird_peak(population, space, baseline, settings)
     caps = [np.full(len(population.members), c.resolve(reference)) for c in problem.caps]
-    cases = design_cases(problem, space, population, caps)
+    cases = design_cases(problem, space, population, caps, baseline)
     chains = sum(case.after is None for case in cases)
     options = study or StudyOptions(workers=1)
     if chains == 1:
@@ -229,6 +230,8 @@ NO_DESIGN = "no design (optimiser error)"
 ROBUST_BASELINE, ROBUST_OPTIMUM = "robustness: baseline", "robustness: optimum"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
+#: the prefix of a population's feasibility screen's cases
+SCREEN = "screen/"
 
 
 @dataclass
@@ -242,24 +245,39 @@ class Kept:
 
 
 def design_cases(problem: DesignProblem, space: DesignSpace, population: Population,
-                 caps: list[np.ndarray]) -> list[Case]:
+                 caps: list[np.ndarray], baseline: Scored) -> list[Case]:
     """Every start's chain of caps, tightest first (each design is feasible
     for the next, looser cap and warm-starts it, so that the hold cannot fall
-    as the cap rises), and a population's single-bird comparison."""
+    as the cap rises), and a population's single-bird comparison. Where the
+    (verified) ``baseline`` breaks a bird's limits at the tightest cap, the
+    feasibility screen's starts come first: the baseline start's tightest
+    cap needs them all (design/solvers/optimize/feasibility.py)."""
     m = problem.multistart
-    starts = starting_designs(space.scale(space.base_values), m.starts, m.seed)
-    cases = []
-    for s, d in enumerate(starts):
-        after = None
-        for k in sorted(range(len(caps)), key=lambda k: caps[k][0]):
-            key = f"start-{s:02d}/cap-{k + 1}" if m.starts > 1 else f"cap-{k + 1}"
-            cases.append(Case(key, {"start": d.tolist(), "start_index": s, "cap_index": k,
-                                    "caps_N": caps[k].tolist()}, after))
-            after = key
+    d0 = space.scale(space.base_values)
+    starts = starting_designs(d0, m.starts, m.seed)
+    order = sorted(range(len(caps)), key=lambda k: caps[k][0])
+    cases, screens = [], []
     if problem.population:
         cases.append(Case(SINGLE_BIRD, {"single_bird": space.baseline.bird.name,
                                         "cap_N": float(caps[0][0])}))
-    return cases
+        b = hardest_bird(baseline, caps[order[0]], CAP_TOLERANCE)
+        spec = problem.population
+        if b is not None:
+            for s, d in enumerate(starting_designs(d0, spec.screen_starts, m.seed)):
+                screens.append(Case(f"{SCREEN}start-{s:02d}", {
+                    "bird": population.members[b].name, "bird_index": b, "start": d.tolist(),
+                    "start_index": s, "cap_N": float(caps[order[0]][b]),
+                    "max_simulations": spec.screen_simulations}))
+    for s, d in enumerate(starts):
+        after = tuple(c.key for c in screens) if s == 0 and screens else None
+        for k in order:
+            key = f"start-{s:02d}/cap-{k + 1}" if m.starts > 1 else f"cap-{k + 1}"
+            cases.append(Case(key, {"start": d.tolist(), "start_index": s, "cap_index": k,
+                                    "caps_N": caps[k].tolist(),
+                                    "screened": isinstance(after, tuple)}, after))
+            after = key
+    # the single-bird comparison first: the longest case, it runs beside the screen
+    return cases[:1] + screens + cases[1:] if problem.population else cases
 
 
 def design_bird_peak(population: Population, space: DesignSpace, baseline: Scored,
@@ -287,15 +305,20 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     settings = problem.settings
     if case.key == SINGLE_BIRD:
         return _single_bird(problem, space, population, case, kept)
+    if case.key.startswith(SCREEN):
+        return _screen(problem, population, case)
     k = case.inputs["cap_index"]
     caps = np.array(case.inputs["caps_N"])
-    start = np.array(upstream["d"]) if upstream else np.array(case.inputs["start"])
-    first = upstream is None and case.inputs["start_index"] == 0
     say(f"cap {k + 1} of {len(problem.caps)}: {caps_text(caps)} "
         f"({problem.caps[k].describe()})")
-    outcome = design_loop(settings)(population, caps, settings, problem.rules,
-                                    None if first else start, progress,
-                                    anchor=upstream is not None)
+    if case.inputs.get("screened"):
+        outcome = _screened(problem, population, caps, case, upstream, progress)
+    else:
+        start = np.array(upstream["d"]) if upstream else np.array(case.inputs["start"])
+        first = upstream is None and case.inputs["start_index"] == 0
+        outcome = design_loop(settings)(population, caps, settings, problem.rules,
+                                        None if first else start, progress,
+                                        anchor=upstream is not None)
     certify(population, outcome, settings, problem.rules, progress)
     if check and k == 0 and problem.model_check != "none":
         check.submit(case.key, population, outcome.best.d)
@@ -329,6 +352,33 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
     return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
             "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
             "peaks_N": fine.peaks.tolist(), "jams": jams(fine), "hold_time_s": fine.hold}
+
+
+def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
+    """One start of the feasibility screen: the pattern search on the hardest
+    bird alone, ended at the first design within its limits."""
+    b = case.inputs["bird_index"]
+    found = screen(Population((population.members[b],)), case.inputs["cap_N"],
+                   problem.settings, problem.rules, np.array(case.inputs["start"]),
+                   case.inputs["max_simulations"])
+    return {"status": "done", "bird": case.inputs["bird"],
+            "start_index": case.inputs["start_index"], **found.row(case.inputs["cap_N"]),
+            "design": population.space.design(found.d)}
+
+
+def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, case: Case,
+              screens: dict, progress: Progress | None) -> Outcome:
+    """The tightest cap's loop after the feasibility screen: from the first
+    start's design within the hardest bird's limits, else not run (the
+    design nearest them, with the screen's evidence)."""
+    rows = list(screens.values())
+    reached = [r for r in rows if r["within"]]
+    if not reached:
+        (progress or (lambda message: None))(
+            f"feasibility screen: no start kept {rows[0]['bird']} within its limits")
+        return unreached(population, caps, problem.settings, rows, rows[0]["bird"])
+    return design_loop(problem.settings)(population, caps, problem.settings, problem.rules,
+                                         np.array(reached[0]["d"]), progress, anchor=True)
 
 
 def jams(scored: Scored) -> list[str]:
@@ -611,6 +661,17 @@ def _diagnosis(space, problem, outcome: Outcome, variables) -> str:
     rules = [tag for margin, tag in rule_margins(values, space.baseline, problem.rules)
              if margin < 1e-6]
     stops = bounds + rules
+    search = outcome.search or {}
+    if search.get("method") == "feasibility screen":
+        rows = search["starts"]
+        return (f"no start of the feasibility screen kept {search['bird']} within its limits "
+                f"(cap {cap:.2f} N, fold forces, no jam): the pattern search on it alone from "
+                f"{len(rows)} starts (the baseline and {len(rows) - 1} Sobol points), "
+                f"{sum(r['simulations'] for r in rows)} designs; each start's nearest design: "
+                + ", ".join(f"peak {r['max_finger_force_N']:.2f} N"
+                            + (" and jammed" if r["jammed"] else "") for r in rows)
+                + f"; the design reported is the nearest (start {search['nearest']}), "
+                f"verified for every bird")
     return (f"no design within the bounds keeps every finger under {cap:.2f} N{bird}: the "
             f"smallest peak force reached is {best.peaks[k]:.2f} N (finger "
             f"{run.summary['max_finger_force_finger']}); "

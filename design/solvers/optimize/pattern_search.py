@@ -41,13 +41,13 @@ from __future__ import annotations
 
 import copy
 import multiprocessing
-import os
 import resource
 import time
 from dataclasses import dataclass
 
 import numpy as np
 
+from design.solvers.optimize.forked import processes
 from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
@@ -91,7 +91,7 @@ class Searched:
 
 
 def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True,
-            max_evaluations: int = MAX_SIMULATIONS, moved=None) -> Searched:
+            max_evaluations: int = MAX_SIMULATIONS, moved=None, enough=None) -> Searched:
     """The coordinate search of the module's docstring on the lattice
     ``clip(d0 + LATTICE * k, 0, 1)`` (scaled variables, integer ``k``).
 
@@ -99,8 +99,9 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     caller may evaluate them in parallel), ``value0`` is ``d0``'s;
     ``beats(a, b)`` says whether value a is better than b; a design that is
     not ``allowed`` is not tried; ``moved(trial, count)`` hears of every
-    step taken. Every decision is a ``beats`` of two values, so the path
-    depends on the values only through those decisions."""
+    step taken; the search ends at the first point (``d0`` or a step taken)
+    whose value is ``enough``. Every decision is a ``beats`` of two values,
+    so the path depends on the values only through those decisions."""
     d0 = np.asarray(d0, float)
     lo, hi = -np.ceil(d0 / LATTICE).astype(int), np.ceil((1 - d0) / LATTICE).astype(int)
     seen: dict[tuple, object] = {(0,) * len(d0): value0}
@@ -127,50 +128,67 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
                 trials.append(trial_at[k])
         return [seen.get(k) for k, _ in tried]
 
+    class Enough(Exception):
+        """A step reached a point whose value is enough."""
+
     def take(k):
         trial_at[k].taken = True
         if moved:
             moved(trial_at[k], len(seen))
+        if enough and enough(seen[k]):
+            raise Enough
 
     def valid(t, k) -> bool:
         return t != k and allowed(point(t))
 
-    k, units = (0,) * len(d0), FIRST_STEP
-    while units >= 1 and len(seen) < max_evaluations:
-        any_move, cut = False, False
-        for i in range(len(d0)):
-            tries = [(t, u) for u in (units, -units) if valid(t := step(k, i, u), k)]
-            values = evaluate(tries, i, "poll") if tries else []
-            cut = cut or any(v is None for v in values)
-            if not values or values[0] is None:
-                continue
-            best = 0 if len(values) == 1 or values[1] is None or \
-                not beats(values[1], values[0]) else 1
-            if not beats(values[best], seen[k]):
-                continue
-            (k, ext), any_move = tries[best], True
-            take(k)
-            # keep going that way, each step twice the last (up to the first
-            # step), two at a time: the pair is evaluated together
-            while True:
-                e1 = min(2 * abs(ext), FIRST_STEP) * (1 if ext > 0 else -1)
-                e2 = min(2 * abs(e1), FIRST_STEP) * (1 if ext > 0 else -1)
-                a = step(k, i, e1)
-                if not valid(a, k):
-                    break
-                b = step(a, i, e2)
-                pair = [(a, e1)] + ([(b, e2)] if valid(b, a) else [])
-                va, *vb = evaluate(pair, i, "extend")
-                if va is None or not beats(va, seen[k]):
-                    break
-                k = a
+    k, units, cut = (0,) * len(d0), FIRST_STEP, False
+
+    def sweeps():
+        """Poll and extend until the step falls below one unit or the budget ends."""
+        nonlocal k, units, cut
+        while units >= 1 and len(seen) < max_evaluations:
+            any_move, cut = False, False
+            for i in range(len(d0)):
+                tries = [(t, u) for u in (units, -units) if valid(t := step(k, i, u), k)]
+                values = evaluate(tries, i, "poll") if tries else []
+                cut = cut or any(v is None for v in values)
+                if not values or values[0] is None:
+                    continue
+                best = 0 if len(values) == 1 or values[1] is None or \
+                    not beats(values[1], values[0]) else 1
+                if not beats(values[best], seen[k]):
+                    continue
+                (k, ext), any_move = tries[best], True
                 take(k)
-                if not vb or vb[0] is None or not beats(vb[0], va):
-                    break
-                k, ext = b, e2
-                take(k)
-        if not any_move:
-            units //= 2
+                # keep going that way, each step twice the last (up to the first
+                # step), two at a time: the pair is evaluated together
+                while True:
+                    e1 = min(2 * abs(ext), FIRST_STEP) * (1 if ext > 0 else -1)
+                    e2 = min(2 * abs(e1), FIRST_STEP) * (1 if ext > 0 else -1)
+                    a = step(k, i, e1)
+                    if not valid(a, k):
+                        break
+                    b = step(a, i, e2)
+                    pair = [(a, e1)] + ([(b, e2)] if valid(b, a) else [])
+                    va, *vb = evaluate(pair, i, "extend")
+                    if va is None or not beats(va, seen[k]):
+                        break
+                    k = a
+                    take(k)
+                    if not vb or vb[0] is None or not beats(vb[0], va):
+                        break
+                    k, ext = b, e2
+                    take(k)
+            if not any_move:
+                units //= 2
+
+    if enough and enough(value0):
+        units, cut = 0, True
+    else:
+        try:
+            sweeps()
+        except Enough:                  # ended where it is enough: no lattice optimum claimed
+            units, cut = 0, True
     # a lattice optimum: the last sweep, at one unit, polled every neighbour
     return Searched(point(k), seen[k], trials, units < 1 and not cut)
 
@@ -204,12 +222,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
 
     d0 = population.space.scale(population.space.base_values)
-    kept_at_start = keeps(population.space, d0, rules)
-
-    def allowed(d) -> bool:
-        return all(kept or not before for kept, before in
-                   zip(keeps(population.space, d, rules), kept_at_start))
-
+    allowed = allowed_by(population.space, rules)
     baseline, = simulate_all([d0])
     check_baseline(population, baseline)
     origin, first = d0, baseline
@@ -289,10 +302,7 @@ class Pairs:
     def __init__(self, population: Population, settings: LoopSettings, integrator,
                  workers: int | None):
         self.job = (population, settings, integrator)
-        wanted = min(2, os.cpu_count() or 1) if workers is None else workers
-        usable = "fork" in multiprocessing.get_all_start_methods() and \
-            not multiprocessing.current_process().daemon
-        self.processes = wanted if wanted > 1 and usable else 1
+        self.processes = processes(workers)
         self.pool = None
         #: the CPU time (s) of the forked processes, once they have ended
         #: (this process's own is in the run's profile)
@@ -325,6 +335,16 @@ def _children_cpu() -> float:
     """User and system CPU time (s) of this process's ended, waited-for children."""
     used = resource.getrusage(resource.RUSAGE_CHILDREN)
     return used.ru_utime + used.ru_stime
+
+
+def allowed_by(space: DesignSpace, rules: Rules):
+    """Whether a scaled design keeps every design rule the baseline keeps."""
+    kept_at_start = keeps(space, space.scale(space.base_values), rules)
+
+    def allowed(d) -> bool:
+        return all(kept or not before for kept, before in
+                   zip(keeps(space, d, rules), kept_at_start))
+    return allowed
 
 
 def keeps(space: DesignSpace, d: np.ndarray, rules: Rules) -> list[bool]:

@@ -46,6 +46,7 @@ import numpy as np
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import GraspRun, simulate_grasp
 from design.solvers.grasp.validity import finger_limits, validity_problems
+from design.solvers.optimize.forked import forked_map
 from design.solvers.optimize.population import Population, PopulationNLP
 from design.solvers.optimize.profile import CONSTRUCTION, OPTIMISER, SIMULATIONS, VIEWS, Profile
 from design.solvers.optimize.schedule import schedule_of
@@ -198,7 +199,9 @@ class Outcome:
     """What the loop found, and how."""
 
     best: Scored
-    baseline: Scored
+    #: the baseline as the loop simulated it (None: not simulated, a
+    #: feasibility screen's answer)
+    baseline: Scored | None
     #: each bird's cap (N)
     caps: np.ndarray
     iterations: list = field(default_factory=list)
@@ -255,10 +258,13 @@ def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
 
 
 def score(population: Population, d: np.ndarray, settings: LoopSettings,
-          integrator: IntegratorSettings | None = None) -> Scored:
-    """Simulate the scaled design ``d`` for every bird of the population."""
-    return Scored(np.asarray(d, float), [simulate(m.space, d, settings, integrator)
-                                         for m in population.members], population)
+          integrator: IntegratorSettings | None = None, workers: int | None = 1) -> Scored:
+    """Simulate the scaled design ``d`` for every bird of the population, the
+    birds in ``workers`` processes (design/solvers/optimize/forked.py; None:
+    one per core, at most two)."""
+    return Scored(np.asarray(d, float),
+                  forked_map(lambda m: simulate(m.space, d, settings, integrator),
+                             population.members, workers), population)
 
 
 def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
@@ -541,13 +547,14 @@ def certify(space: DesignSpace | Population, outcome: Outcome, settings: LoopSet
 
 
 def verify(space: DesignSpace | Population, d: np.ndarray, settings: LoopSettings,
-           factor: float = 4.0) -> Scored:
+           factor: float = 4.0, workers: int | None = None) -> Scored:
     """Re-simulate every bird at ``factor`` times the optimiser's resolution:
     steps no longer than its grid step / factor, tolerances tightened by
-    factor^4."""
+    factor^4; the birds in ``workers`` processes (None: one per core, at
+    most two)."""
     s = settings.simulator
     fine = replace(s.finer(factor), max_step=min(s.max_step, settings.nlp.time_step) / factor)
-    return score(population_of(space), d, settings, fine)
+    return score(population_of(space), d, settings, fine, workers)
 
 
 def verdict(nlp_hold: float, verified: Evaluated, cap: float) -> dict:

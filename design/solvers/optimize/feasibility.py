@@ -1,0 +1,130 @@
+"""The feasibility screen: can any design keep a population's hardest bird within its limits?
+
+A robust design must keep every bird within its limits: its cap, its
+fingers' fold forces, no jam. The population's pattern search pays one
+simulation per bird for every design it tries. Where the baseline breaks a
+bird's limits, the screen first asks a cheaper question of the bird
+furthest from them at the baseline (:meth:`Scored.shortfall`'s order:
+failed runs, then jams, then the largest force over a limit), since no
+design keeps the population within its limits unless it keeps that bird:
+
+* the pattern search runs on that bird alone, from each of several starts
+  (the baseline and points of a scrambled Sobol sequence, as a multistart's:
+  design/solvers/optimize/multistart.py), comparing designs as the
+  population's search does, each ending at the first design within the
+  bird's limits or when its budget of simulations is spent;
+* a design within them starts the population's search;
+* if no start reaches one, the population's search is not run: the answer
+  is the design nearest the limits, simulated for every bird, with every
+  start's evidence. It is the evidence of a local search from each start,
+  not a proof over the whole box: the result names the starts, the designs
+  simulated and the nearest shortfall of each.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from design.solvers.optimize.pattern_search import HOLD_BAND, Pairs, allowed_by, compass
+from design.solvers.optimize.population import Population
+from design.solvers.optimize.transcription import Rules
+from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, better,
+                                                   score)
+
+#: the screen's starts and each one's budget of simulations, by default:
+#: the baseline and three Sobol points, each given 16 simulations (its own
+#: and about one poll of eight variables at the first step)
+STARTS, SIMULATIONS = 4, 16
+
+
+def alone(scored: Scored, b: int) -> Scored:
+    """Bird ``b``'s part of a design scored for a population."""
+    return Scored(scored.d, [scored.members[b]], Population((scored.population.members[b],)))
+
+
+def hardest_bird(baseline: Scored, caps, tolerance: float) -> int | None:
+    """The bird furthest from its limits (cap in N, fold forces, no jam) at
+    ``baseline`` in :meth:`Scored.shortfall`'s order, the first of equals;
+    None where every bird keeps them within ``tolerance`` (relative)."""
+    caps = np.broadcast_to(np.asarray(caps, float), (len(baseline.members),))
+    if baseline.within(caps, tolerance):
+        return None
+    shortfalls = [alone(baseline, b).shortfall(caps[b], tolerance)
+                  for b in range(len(baseline.members))]
+    return max(range(len(shortfalls)), key=lambda b: (shortfalls[b], -b))
+
+
+@dataclass
+class Screened:
+    """One start of the screen: where it started and ended (scaled designs),
+    the end's value (the bird alone), how many designs it simulated, and
+    whether the end keeps the bird within its limits."""
+
+    start: np.ndarray
+    d: np.ndarray
+    value: Scored
+    simulations: int
+    within: bool
+
+    def row(self, cap: float) -> dict:
+        """What a case keeps of it (JSON), SI: the shortfall as
+        :meth:`Scored.shortfall` gives it, failed runs, jams, N over a limit."""
+        failed, jammed, over = self.value.shortfall(cap)
+        summary = self.value.run.summary
+        return {"start": self.start.tolist(), "d": self.d.tolist(), "within": self.within,
+                "simulations": self.simulations, "failed_runs": failed, "jammed": jammed,
+                "over_limit_N": over, "hold_time_s": self.value.hold,
+                "max_finger_force_N": self.value.peak,
+                "max_finger_force_finger": summary["max_finger_force_finger"],
+                "jam": "; ".join(summary["jam"]) or "none"}
+
+
+def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
+           start: np.ndarray, budget: int = SIMULATIONS, workers: int | None = None
+           ) -> Screened:
+    """The pattern search on one ``bird`` (a population of one) from the
+    scaled ``start`` under ``cap`` (N), ending at the first design within its
+    limits or after ``budget`` simulations (the start's included)."""
+    start = np.asarray(start, float)
+    pool = Pairs(bird, settings, settings.simulator, workers)
+
+    def beats(a: Scored, b: Scored) -> bool:
+        return better(a, b, cap, tolerance=0.0, band=HOLD_BAND)
+
+    def within(value: Scored) -> bool:
+        return value.within(cap)
+
+    with pool:
+        first, = pool.score([start])
+        found = compass(pool.score, start, first, beats, allowed_by(bird.space, rules),
+                        budget, enough=within)
+    return Screened(start, found.d, found.value, len(found.trials) + 1, within(found.value))
+
+
+def nearest(rows: list[dict]) -> int:
+    """The screen row nearest its limits (fewest failed runs, then jams,
+    then the least force over a limit), the first of equals."""
+    return min(range(len(rows)), key=lambda i: (rows[i]["failed_runs"], rows[i]["jammed"],
+                                                rows[i]["over_limit_N"], i))
+
+
+def unreached(population: Population, caps, settings: LoopSettings, rows: list[dict],
+              bird: str) -> Outcome:
+    """The answer where no start of the screen reached the limits of
+    ``bird``: the design nearest them, simulated for every bird as the
+    search simulates, its own simulation as the claim; ``search`` holds the
+    screen's every start."""
+    caps = np.broadcast_to(np.asarray(caps, float), (len(population.members),)).copy()
+    k = nearest(rows)
+    best = score(population, np.array(rows[k]["d"]), settings, workers=None)
+    out = Outcome(best, None, caps)
+    source = "the feasibility screen's simulation (as the pattern search simulates)"
+    out.claims = [(m.hold, source) for m in best.members]
+    out.claim = best.hold, source
+    out.search = {"method": "feasibility screen", "bird": bird, "starts": rows, "nearest": k,
+                  "simulations": sum(r["simulations"] for r in rows) + len(population.members),
+                  "rtol": settings.simulator.rtol, "caps_N": caps.tolist()}
+    return out
+
