@@ -50,10 +50,19 @@ def population_entry(result: dict) -> dict:
             f" {b[f'{label}_hold_time_s']:8.4f} s {b[f'{label}_max_finger_force_N']:7.2f} N "
             f"{'jam' if b[f'{label}_jam'] != 'none' else 'no jam':>6s}" + " " * 15
             for label in labels))
+    search = result["solver"]["search"]
+    screen = search if search["method"] == "feasibility screen" else None
+    if screen:
+        print(f"\nfeasibility screen on {screen['bird']}: start, simulations, within limits, "
+              f"jammed, peak (N)")
+        for r in screen["starts"]:
+            print(f"{r['start_index']:5d} {r['simulations']:5d} {str(r['within']):>6s} "
+                  f"{r['jammed']:3d} {r['max_finger_force_N']:8.2f}")
     return {"cap_N": result["cap"]["N"], "birds": p["birds"],
             "hold_time_s": p["hold_time_s"], "limiting_bird": p["limiting_bird"],
             "single_bird_design": p["single_bird_design"], "robust_design": result["design"],
-            "simulations": result["solver"]["search"]["simulations"]}
+            "simulations": search["simulations"], "screen": screen,
+            "profile": result["profile"]}
 
 
 def line_entry(result: dict) -> dict:

@@ -347,10 +347,22 @@ def population(path: Path, data: dict) -> list[str]:
         columns.update({f"{words}: hold (s)": lambda r, k=key: r[f"{k}_hold_time_s"],
                         f"{words}: peak (N)": lambda r, k=key: r[f"{k}_max_finger_force_N"],
                         f"{words}: jam": lambda r, k=key: r[f"{k}_jam"]})
+    screen = p.get("screen")
+    simulated = f"{p['simulations']} simulations of the feasibility screen" if screen else \
+        f"{p['simulations']} designs simulated for every bird"
     lines = [f"`{p['command']}`: {p['status']} in {p['wall_time_s']:.0f} s on {p['workers']} "
-             f"workers ({p['simulations']} designs simulated for every bird), caps "
-             f"{caps(p['cap_N'])}: {p['message']}", "", "Each bird at 4x finer "
-             "resolution:", "", *table(p["birds"], columns)]
+             f"workers ({simulated}), caps {caps(p['cap_N'])}: {p['message']}", ""]
+    if screen:
+        lines += [f"The feasibility screen: the pattern search on {screen['bird']} alone "
+                  "from each start, each start's nearest design (its own simulation):", "",
+                  *table(screen["starts"], {
+                      "start": lambda r: r["start_index"],
+                      "simulations": lambda r: r["simulations"],
+                      "within limits": lambda r: r["within"],
+                      "jammed": lambda r: r["jammed"],
+                      "peak (N)": lambda r: r["max_finger_force_N"],
+                      "finger": lambda r: r["max_finger_force_finger"]}), ""]
+    lines += ["Each bird at 4x finer resolution:", "", *table(p["birds"], columns)]
     return section("The flock: one design for Table 5-5's birds", "flock population", path, p,
                    lines)
 

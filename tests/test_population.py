@@ -11,6 +11,7 @@ the [0, 1] box of the short grasp (tests/design_cases.py).
 """
 
 import copy
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -18,14 +19,15 @@ import pytest
 
 from design.io.scene import load_scene
 from design.errors import ProblemFileError
+from design.solvers.optimize.feasibility import SIMULATIONS, STARTS, hardest_bird, nearest
 from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.transcription import NLPSettings
 from design.run.solve import population_comparison
-from design.solvers.optimize.trust_region import verify
+from design.solvers.optimize.trust_region import Scored, verify
 from tests import prefetch
-from tests.design_cases import (LOOP, sharing_simulations, single_bird_inputs,
-                                single_bird_optimum, stiffness_space)
+from tests.design_cases import (LOOP, sharing_simulations, short_problem_file,
+                                single_bird_inputs, single_bird_optimum, stiffness_space)
 
 NLP = NLPSettings(time_step=0.01, max_iter=60)
 
@@ -196,3 +198,103 @@ def test_the_population_table_gives_each_designs_hold_peak_and_jam():
     assert (row["single_bird_optimum_hold_time_s"], row["robust_optimum_hold_time_s"]) == \
         (0.25, base.hold)
     assert row["robust_optimum_max_finger_force_N"] == base.peak
+
+
+def _two_birds(caps_scale=(1.5, 1.5)):
+    """The short grasp's verified baseline as a population of two copies of
+    its bird, and caps (N) of ``caps_scale`` times its peak."""
+    space = stiffness_space("lower", hi=2.0)
+    with sharing_simulations():
+        base = verify(space, space.scale(space.base_values), LOOP)
+    members = [base.members[0], copy.deepcopy(base.members[0])]
+    two = Scored(base.d, members, Population((Member("a", space), Member("b", space))))
+    return two, base.peak * np.asarray(caps_scale)
+
+
+def test_the_screen_takes_the_bird_furthest_from_its_limits():
+    """No screen where every bird keeps its limits; else the bird whose
+    finger presses furthest over its cap, the first of equals, and a jammed
+    bird before one that only presses too hard."""
+    two, caps = _two_birds()
+    assert hardest_bird(two, caps, 0.0) is None
+    assert hardest_bird(two, caps * [1.0, 0.5], 0.0) == 1
+    assert hardest_bird(two, caps * [0.5, 0.9], 0.0) == 0
+    assert hardest_bird(two, caps * 0.5, 0.0) == 0
+    two.members[1].run.summary["jam"] = ["the bird is still held off the belt when the run "
+                                         "ends at 1.450 s (by 5b)"]
+    assert hardest_bird(two, caps * [0.5, 1.0], 0.0) == 1
+
+
+def test_the_nearest_screen_row_has_fewest_failures_then_jams_then_force_over():
+    rows = [{"failed_runs": 0, "jammed": 1, "over_limit_N": 1.0},
+            {"failed_runs": 0, "jammed": 0, "over_limit_N": 30.0},
+            {"failed_runs": 0, "jammed": 0, "over_limit_N": 12.0},
+            {"failed_runs": 1, "jammed": 0, "over_limit_N": 0.0},
+            {"failed_runs": 0, "jammed": 0, "over_limit_N": 12.0}]
+    assert nearest(rows) == 2
+
+
+def _population_problem(tmp_path, screen=None):
+    path = short_problem_file(tmp_path / "p.yaml", {"groups.lower.stiffness_scale": [0.5, 2.0]})
+    data = json.loads(path.read_text())
+    data["population"] = {"birds": ["models/birds/small_1_20kg.yaml",
+                                    "models/birds/large_2_30kg.yaml"],
+                          **({"screen": screen} if screen else {})}
+    return load_scene(data)
+
+
+def test_a_baseline_that_breaks_a_birds_limits_is_screened_first(tmp_path):
+    """The screen's starts (the baseline and Sobol points) are cases of their
+    own; the baseline start's cap needs every one of them; the single-bird
+    comparison comes first, to run beside them. A baseline within every
+    bird's limits is not screened."""
+    from design.run.solve import SCREEN, SINGLE_BIRD, design_cases
+
+    problem = _population_problem(tmp_path, {"starts": 3, "max_simulations": 5})
+    two, caps = _two_birds()
+    space = two.population.space
+    cases = design_cases(problem, space, two.population, [caps * [1.0, 0.5]], two)
+    assert [c.key for c in cases] == [SINGLE_BIRD, f"{SCREEN}start-00", f"{SCREEN}start-01",
+                                      f"{SCREEN}start-02", "cap-1"]
+    screens, cap = cases[1:4], cases[-1]
+    assert cap.after == tuple(c.key for c in screens) and cap.inputs["screened"]
+    assert [c.inputs["bird_index"] for c in screens] == [1, 1, 1]
+    assert [c.inputs["max_simulations"] for c in screens] == [5, 5, 5]
+    assert screens[0].inputs["start"] == space.scale(space.base_values).tolist()
+    assert screens[0].inputs["cap_N"] == pytest.approx(caps[1] * 0.5)
+    plain = design_cases(problem, space, two.population, [caps], two)
+    assert [c.key for c in plain] == [SINGLE_BIRD, "cap-1"] and plain[-1].after is None
+    assert not plain[-1].inputs["screened"]
+
+
+def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(
+        tmp_path, monkeypatch):
+    """A start within the hardest bird's limits starts the population's
+    search (the first such start, anchored to the baseline); none, and the
+    search is not run: the answer is the screen's nearest design."""
+    from design.run import solve
+
+    problem = _population_problem(tmp_path)
+    calls = []
+    monkeypatch.setattr(solve, "design_loop", lambda settings: lambda *a, **k: calls.append(
+        ("search", a[4], k["anchor"])) or "searched")
+    monkeypatch.setattr(solve, "unreached", lambda population, caps, settings, rows, bird:
+                        calls.append(("unreached", [r["d"] for r in rows], bird)) or "nearest")
+    row = {"bird": "large-bird-2.30kg", "within": False, "d": [0.1]}
+    rows = {"s0": row, "s1": {**row, "within": True, "d": [0.7]},
+            "s2": {**row, "within": True, "d": [0.9]}}
+    assert solve._screened(problem, None, np.ones(2), None, rows, None) == "searched"
+    assert calls[-1][0] == "search" and calls[-1][1].tolist() == [0.7] and calls[-1][2]
+    missed = {k: {**r, "within": False} for k, r in rows.items()}
+    assert solve._screened(problem, None, np.ones(2), None, missed, None) == "nearest"
+    assert calls[-1] == ("unreached", [[0.1], [0.7], [0.9]], "large-bird-2.30kg")
+
+
+def test_screen_settings_are_read_and_checked(tmp_path):
+    problem = _population_problem(tmp_path)
+    assert (problem.population.screen_starts, problem.population.screen_simulations) == \
+        (STARTS, SIMULATIONS)
+    with pytest.raises(ProblemFileError, match="population.screen.starts"):
+        _population_problem(tmp_path, {"starts": 0})
+    with pytest.raises(ProblemFileError, match="population.screen.budget: unknown key"):
+        _population_problem(tmp_path, {"budget": 3})

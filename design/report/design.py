@@ -112,15 +112,36 @@ def population_section(page: Page, population: dict) -> None:
               f"{'' if population['within_caps']['single_bird_optimum'] else ', breaks a cap'}"
               f"), robust optimum {holds['robust_optimum']:.4f} s "
               f"({limiting['robust_optimum']}). Every number is from the independent "
-              f"simulation at 4x the optimiser's resolution.")
+              f"simulation at 4x the optimiser's resolution."
+              + (f" The robust optimum is {population['robust_optimum_is']}."
+                 if population.get("robust_optimum_is") else ""))
     page.table(population["birds"], "Hold (s), peak finger force (N) and jam of every bird",
                "population-table")
+
+
+def screen_table(page: Page, search: dict) -> None:
+    """The feasibility screen's starts: where each ended, and how far from the limits."""
+    page.text(f"Feasibility screen (design/solvers/optimize/feasibility.py): the pattern "
+              f"search on {search['bird']} alone, the bird furthest from its limits at the "
+              f"baseline, from {len(search['starts'])} starts, each ending at the first design "
+              f"within its limits or at its budget; {search['simulations']} simulations in "
+              f"all, the last of them the nearest design for every bird. No start reached the "
+              f"limits, so the population's search did not run.")
+    page.table([{"start": r["start_index"], "simulations": r["simulations"],
+                 "within limits": r["within"], "failed runs": r["failed_runs"],
+                 "jammed": r["jammed"], "force over a limit (N)": r["over_limit_N"],
+                 "peak (N)": r["max_finger_force_N"], "finger": r["max_finger_force_finger"],
+                 "hold (s)": r["hold_time_s"], **r["design"]} for r in search["starts"]],
+               "Feasibility screen: each start's nearest design", "screen-table")
 
 
 def search_table(page: Page, solver: dict) -> None:
     """The pattern search's simulations, in order: the step (scaled), the
     variable moved, the simulated hold and peak, and whether it was taken."""
     s = solver["search"]
+    if s["method"] == "feasibility screen":
+        screen_table(page, s)
+        return
     page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "

@@ -213,6 +213,11 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
     if problem.population:
         comparison = population_comparison(
             space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
+        search = entries[0]["solver"]["search"] or {}
+        if search.get("method") == "feasibility screen":
+            comparison["robust_optimum_is"] = (
+                f"the feasibility screen's design nearest {search['bird']}'s limits: no "
+                f"start reached them, and the population's search did not run")
         note = better_known(comparison)
         if note:
             comparison["better_known"] = note
