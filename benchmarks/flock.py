@@ -54,10 +54,10 @@ def population_entry(result: dict) -> dict:
     screen = search if search["method"] == "feasibility screen" else None
     if screen:
         print(f"\nfeasibility screen on {screen['bird']}: start, simulations, within limits, "
-              f"jammed, peak (N)")
+              f"jammed, hold (s), peak (N)")
         for r in screen["starts"]:
             print(f"{r['start_index']:5d} {r['simulations']:5d} {str(r['within']):>6s} "
-                  f"{r['jammed']:3d} {r['max_finger_force_N']:8.2f}")
+                  f"{r['jammed']:3d} {r['hold_time_s']:8.4f} {r['max_finger_force_N']:8.2f}")
     return {"cap_N": result["cap"]["N"], "birds": p["birds"],
             "hold_time_s": p["hold_time_s"], "limiting_bird": p["limiting_bird"],
             "single_bird_design": p["single_bird_design"], "robust_design": result["design"],

@@ -354,12 +354,13 @@ def population(path: Path, data: dict) -> list[str]:
              f"workers ({simulated}), caps {caps(p['cap_N'])}: {p['message']}", ""]
     if screen:
         lines += [f"The feasibility screen: the pattern search on {screen['bird']} alone "
-                  "from each start, each start's nearest design (its own simulation):", "",
+                  "from each start, where each start ended (its own simulation):", "",
                   *table(screen["starts"], {
                       "start": lambda r: r["start_index"],
                       "simulations": lambda r: r["simulations"],
                       "within limits": lambda r: r["within"],
                       "jammed": lambda r: r["jammed"],
+                      "hold (s)": lambda r: r["hold_time_s"],
                       "peak (N)": lambda r: r["max_finger_force_N"],
                       "finger": lambda r: r["max_finger_force_finger"]}), ""]
     lines += ["Each bird at 4x finer resolution:", "", *table(p["birds"], columns)]

@@ -19,7 +19,7 @@ import pytest
 
 from design.io.scene import load_scene
 from design.errors import ProblemFileError
-from design.solvers.optimize.feasibility import SIMULATIONS, STARTS, hardest_bird, nearest
+from design.solvers.optimize.feasibility import SIMULATIONS, STARTS, best_row, hardest_bird
 from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.transcription import NLPSettings
@@ -225,13 +225,17 @@ def test_the_screen_takes_the_bird_furthest_from_its_limits():
     assert hardest_bird(two, caps * [0.5, 1.0], 0.0) == 1
 
 
-def test_the_nearest_screen_row_has_fewest_failures_then_jams_then_force_over():
-    rows = [{"failed_runs": 0, "jammed": 1, "over_limit_N": 1.0},
-            {"failed_runs": 0, "jammed": 0, "over_limit_N": 30.0},
-            {"failed_runs": 0, "jammed": 0, "over_limit_N": 12.0},
-            {"failed_runs": 1, "jammed": 0, "over_limit_N": 0.0},
-            {"failed_runs": 0, "jammed": 0, "over_limit_N": 12.0}]
-    assert nearest(rows) == 2
+def test_the_best_screen_row_is_within_limits_then_nearest_them():
+    """Within the limits, the longer hold; else fewest failed runs, then
+    jams, then the least force over a limit; the first of equals."""
+    def row(within, hold, failed=0, jammed=0, over=-1.0):
+        return {"within": within, "hold_time_s": hold, "failed_runs": failed,
+                "jammed": jammed, "over_limit_N": over}
+    rows = [row(False, 0.5, jammed=1, over=1.0), row(False, 0.4, over=30.0),
+            row(False, 0.3, over=12.0), row(False, 0.0, failed=1, over=0.0),
+            row(False, 0.3, over=12.0)]
+    assert best_row(rows) == 2
+    assert best_row(rows + [row(True, 0.0), row(True, 0.1), row(True, 0.1)]) == 6
 
 
 def _population_problem(tmp_path, screen=None):
@@ -262,6 +266,8 @@ def test_a_baseline_that_breaks_a_birds_limits_is_screened_first(tmp_path):
     assert [c.inputs["max_simulations"] for c in screens] == [5, 5, 5]
     assert screens[0].inputs["start"] == space.scale(space.base_values).tolist()
     assert screens[0].inputs["cap_N"] == pytest.approx(caps[1] * 0.5)
+    # the shortest hold is no longer than the screened bird's: it must beat the baseline's
+    assert screens[0].inputs["beyond_s"] == two.hold
     plain = design_cases(problem, space, two.population, [caps], two)
     assert [c.key for c in plain] == [SINGLE_BIRD, "cap-1"] and plain[-1].after is None
     assert not plain[-1].inputs["screened"]
@@ -271,7 +277,7 @@ def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(
         tmp_path, monkeypatch):
     """A start within the hardest bird's limits starts the population's
     search (the first such start, anchored to the baseline); none, and the
-    search is not run: the answer is the screen's nearest design."""
+    search is not run: the answer is the screen's best design."""
     from design.run import solve
 
     problem = _population_problem(tmp_path)
@@ -280,12 +286,12 @@ def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(
         ("search", a[4], k["anchor"])) or "searched")
     monkeypatch.setattr(solve, "unreached", lambda population, caps, settings, rows, bird:
                         calls.append(("unreached", [r["d"] for r in rows], bird)) or "nearest")
-    row = {"bird": "large-bird-2.30kg", "within": False, "d": [0.1]}
-    rows = {"s0": row, "s1": {**row, "within": True, "d": [0.7]},
-            "s2": {**row, "within": True, "d": [0.9]}}
+    row = {"bird": "large-bird-2.30kg", "reached": False, "d": [0.1]}
+    rows = {"s0": row, "s1": {**row, "reached": True, "d": [0.7]},
+            "s2": {**row, "reached": True, "d": [0.9]}}
     assert solve._screened(problem, None, np.ones(2), None, rows, None) == "searched"
     assert calls[-1][0] == "search" and calls[-1][1].tolist() == [0.7] and calls[-1][2]
-    missed = {k: {**r, "within": False} for k, r in rows.items()}
+    missed = {k: {**r, "reached": False} for k, r in rows.items()}
     assert solve._screened(problem, None, np.ones(2), None, missed, None) == "nearest"
     assert calls[-1] == ("unreached", [[0.1], [0.7], [0.9]], "large-bird-2.30kg")
 
@@ -298,3 +304,22 @@ def test_screen_settings_are_read_and_checked(tmp_path):
         _population_problem(tmp_path, {"starts": 0})
     with pytest.raises(ProblemFileError, match="population.screen.budget: unknown key"):
         _population_problem(tmp_path, {"budget": 3})
+
+
+def test_an_unreached_screen_says_what_it_looked_for_and_where_each_start_ended():
+    from design.run.solve import screen_diagnosis
+
+    def row(start, hold, peak, within=False, jammed=0):
+        return {"start_index": start, "hold_time_s": hold, "max_finger_force_N": peak,
+                "within": within, "jammed": jammed, "simulations": 16, "beyond_s": 0.0}
+    search = {"bird": "large-bird-2.30kg", "best": 1,
+              "starts": [row(0, 0.44, 48.4, jammed=1), row(1, 0.0, 5.6, within=True),
+                         row(2, 0.56, 76.9)]}
+    text = screen_diagnosis(search, 19.6)
+    assert text.startswith("no design found that keeps large-bird-2.30kg within its limits "
+                           "(cap 19.60 N, fold forces, no jam) and holds it longer than the "
+                           "baseline's worst hold, 0.0000 s")
+    assert "from 3 starts (the baseline and 2 Sobol points), 48 designs" in text
+    assert ("start 0: hold 0.4400 s, peak 48.40 N, jammed; start 1: hold 0.0000 s, peak "
+            "5.60 N; start 2: hold 0.5600 s, peak 76.90 N, over a limit") in text
+    assert text.endswith("the design reported is start 1's, verified for every bird")

@@ -121,18 +121,21 @@ def population_section(page: Page, population: dict) -> None:
 
 def screen_table(page: Page, search: dict) -> None:
     """The feasibility screen's starts: where each ended, and how far from the limits."""
+    beyond = search["starts"][0].get("beyond_s")
     page.text(f"Feasibility screen (design/solvers/optimize/feasibility.py): the pattern "
               f"search on {search['bird']} alone, the bird furthest from its limits at the "
               f"baseline, from {len(search['starts'])} starts, each ending at the first design "
-              f"within its limits or at its budget; {search['simulations']} simulations in "
-              f"all, the last of them the nearest design for every bird. No start reached the "
-              f"limits, so the population's search did not run.")
+              f"within its limits" + (f" that holds it longer than {beyond:.4f} s (the "
+                                      f"baseline's worst hold)" if beyond is not None else "")
+              + f", or at its budget; {search['simulations']} simulations in all, the last "
+              f"of them the best start's design for every bird. No start reached that, so "
+              f"the population's search did not run.")
     page.table([{"start": r["start_index"], "simulations": r["simulations"],
                  "within limits": r["within"], "failed runs": r["failed_runs"],
                  "jammed": r["jammed"], "force over a limit (N)": r["over_limit_N"],
                  "peak (N)": r["max_finger_force_N"], "finger": r["max_finger_force_finger"],
                  "hold (s)": r["hold_time_s"], **r["design"]} for r in search["starts"]],
-               "Feasibility screen: each start's nearest design", "screen-table")
+               "Feasibility screen: where each start ended", "screen-table")
 
 
 def search_table(page: Page, solver: dict) -> None:

@@ -216,8 +216,9 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
         search = entries[0]["solver"]["search"] or {}
         if search.get("method") == "feasibility screen":
             comparison["robust_optimum_is"] = (
-                f"the feasibility screen's design nearest {search['bird']}'s limits: no "
-                f"start reached them, and the population's search did not run")
+                f"the feasibility screen's best design for {search['bird']}: no start held "
+                f"it within its limits longer than the baseline, and the population's "
+                f"search did not run")
         note = better_known(comparison)
         if note:
             comparison["better_known"] = note
@@ -268,11 +269,13 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
         b = hardest_bird(baseline, caps[order[0]], CAP_TOLERANCE)
         spec = problem.population
         if b is not None:
+            # the shortest hold is no longer than this bird's: it must beat the baseline's
+            beyond = baseline.hold if population.aggregate == "worst" else None
             for s, d in enumerate(starting_designs(d0, spec.screen_starts, m.seed)):
                 screens.append(Case(f"{SCREEN}start-{s:02d}", {
                     "bird": population.members[b].name, "bird_index": b, "start": d.tolist(),
                     "start_index": s, "cap_N": float(caps[order[0]][b]),
-                    "max_simulations": spec.screen_simulations}))
+                    "max_simulations": spec.screen_simulations, "beyond_s": beyond}))
     for s, d in enumerate(starts):
         after = tuple(c.key for c in screens) if s == 0 and screens else None
         for k in order:
@@ -361,26 +364,27 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
 
 def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
     """One start of the feasibility screen: the pattern search on the hardest
-    bird alone, ended at the first design within its limits."""
+    bird alone, ended at the first design that reaches its goal."""
     b = case.inputs["bird_index"]
     found = screen(Population((population.members[b],)), case.inputs["cap_N"],
                    problem.settings, problem.rules, np.array(case.inputs["start"]),
-                   case.inputs["max_simulations"])
-    return {"status": "done", "bird": case.inputs["bird"],
-            "start_index": case.inputs["start_index"], **found.row(case.inputs["cap_N"]),
+                   case.inputs["max_simulations"], case.inputs["beyond_s"])
+    return {"status": "done", "verified": False, "bird": case.inputs["bird"],
+            "start_index": case.inputs["start_index"], "beyond_s": case.inputs["beyond_s"],
+            **found.row(case.inputs["cap_N"]),
             "design": population.space.design(found.d)}
 
 
 def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, case: Case,
               screens: dict, progress: Progress | None) -> Outcome:
     """The tightest cap's loop after the feasibility screen: from the first
-    start's design within the hardest bird's limits, else not run (the
-    design nearest them, with the screen's evidence)."""
+    start's design that reached the screen's goal, else not run (the best
+    start's design, with the screen's evidence)."""
     rows = list(screens.values())
-    reached = [r for r in rows if r["within"]]
+    reached = [r for r in rows if r["reached"]]
     if not reached:
         (progress or (lambda message: None))(
-            f"feasibility screen: no start kept {rows[0]['bird']} within its limits")
+            f"feasibility screen: no start held {rows[0]['bird']} within its limits")
         return unreached(population, caps, problem.settings, rows, rows[0]["bird"])
     return design_loop(problem.settings)(population, caps, problem.settings, problem.rules,
                                          np.array(reached[0]["d"]), progress, anchor=True)
@@ -638,6 +642,8 @@ def _status(space, problem, outcome: Outcome, check, fine: Scored, variables
         return NO_IMPROVEMENT, ("the design loop found no design that holds longer under "
                                 "the cap; the design reported is the baseline, unchanged"
                                 + failures)
+    if (outcome.search or {}).get("method") == "feasibility screen":
+        return FAILED, _diagnosis(space, problem, outcome, variables)
     if check["passed"] and check["model_warnings"]:
         return VERIFIED, ("verified by a model outside its validity: the independent "
                           "simulation confirms the design, but the grasp model is outside "
@@ -668,20 +674,33 @@ def _diagnosis(space, problem, outcome: Outcome, variables) -> str:
     stops = bounds + rules
     search = outcome.search or {}
     if search.get("method") == "feasibility screen":
-        rows = search["starts"]
-        return (f"no start of the feasibility screen kept {search['bird']} within its limits "
-                f"(cap {cap:.2f} N, fold forces, no jam): the pattern search on it alone from "
-                f"{len(rows)} starts (the baseline and {len(rows) - 1} Sobol points), "
-                f"{sum(r['simulations'] for r in rows)} designs; each start's nearest design: "
-                + ", ".join(f"peak {r['max_finger_force_N']:.2f} N"
-                            + (" and jammed" if r["jammed"] else "") for r in rows)
-                + f"; the design reported is the nearest (start {search['nearest']}), "
-                f"verified for every bird")
+        return screen_diagnosis(search, cap)
     return (f"no design within the bounds keeps every finger under {cap:.2f} N{bird}: the "
             f"smallest peak force reached is {best.peaks[k]:.2f} N (finger "
             f"{run.summary['max_finger_force_finger']}); "
             + ("active: " + ", ".join(stops) if stops else
                "no bound or rule is active: the trust-region loop stopped at a local optimum"))
+
+
+def screen_diagnosis(search: dict, cap: float) -> str:
+    """Why the population's search did not run: what the feasibility
+    screen looked for and where each of its starts ended."""
+    rows = search["starts"]
+    beyond = rows[0].get("beyond_s")
+    goal = f" and holds it longer than the baseline's worst hold, {beyond:.4f} s" \
+        if beyond is not None else ""
+    ends = "; ".join(
+        f"start {r['start_index']}: hold {r['hold_time_s']:.4f} s, peak "
+        f"{r['max_finger_force_N']:.2f} N" + ("" if r["within"] else
+                                               ", jammed" if r["jammed"] else ", over a limit")
+        for r in rows)
+    return (f"no design found that keeps {search['bird']} within its limits (cap {cap:.2f} N, "
+            f"fold forces, no jam){goal}, so none holds the population better than the "
+            f"baseline: the feasibility screen's pattern search on that bird alone from "
+            f"{len(rows)} starts (the baseline and {len(rows) - 1} Sobol points), "
+            f"{sum(r['simulations'] for r in rows)} designs, each start's best: {ends}; the "
+            f"design reported is start {rows[search['best']]['start_index']}'s, verified for "
+            f"every bird")
 
 
 def _pareto_row(entry: dict) -> dict:

@@ -194,5 +194,6 @@ class Chord:
                 return z
             if not np.isfinite(size):
                 return None
-            z -= inverse @ r
+            with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None above
+                z -= inverse @ r
         return None

@@ -1,24 +1,27 @@
-"""The feasibility screen: can any design keep a population's hardest bird within its limits?
+"""The feasibility screen: can any design hold a population's hardest bird, within its limits?
 
 A robust design must keep every bird within its limits: its cap, its
 fingers' fold forces, no jam. The population's pattern search pays one
 simulation per bird for every design it tries. Where the baseline breaks a
 bird's limits, the screen first asks a cheaper question of the bird
 furthest from them at the baseline (:meth:`Scored.shortfall`'s order:
-failed runs, then jams, then the largest force over a limit), since no
-design keeps the population within its limits unless it keeps that bird:
+failed runs, then jams, then the largest force over a limit). No design
+holds the population better than the baseline unless it keeps that bird
+within its limits, and, for the shortest hold (``worst``), holds it longer
+than the baseline holds its worst bird: a design that does not lift the
+bird at all keeps it within its limits and holds nobody.
 
-* the pattern search runs on that bird alone, from each of several starts
+* The pattern search runs on that bird alone, from each of several starts
   (the baseline and points of a scrambled Sobol sequence, as a multistart's:
   design/solvers/optimize/multistart.py), comparing designs as the
-  population's search does, each ending at the first design within the
-  bird's limits or when its budget of simulations is spent;
-* a design within them starts the population's search;
-* if no start reaches one, the population's search is not run: the answer
-  is the design nearest the limits, simulated for every bird, with every
-  start's evidence. It is the evidence of a local search from each start,
-  not a proof over the whole box: the result names the starts, the designs
-  simulated and the nearest shortfall of each.
+  population's search does. Each start ends at the first design that
+  reaches the goal above, or when its budget of simulations is spent.
+* A design that reaches it starts the population's search.
+* If no start reaches one, the population's search is not run: the answer
+  is each start's best, the best of them simulated for every bird. It is
+  the evidence of a local search from each start, not a proof over the
+  whole box: the result names the starts, the designs simulated and where
+  each ended.
 """
 
 from __future__ import annotations
@@ -59,14 +62,16 @@ def hardest_bird(baseline: Scored, caps, tolerance: float) -> int | None:
 @dataclass
 class Screened:
     """One start of the screen: where it started and ended (scaled designs),
-    the end's value (the bird alone), how many designs it simulated, and
-    whether the end keeps the bird within its limits."""
+    the end's value (the bird alone), how many designs it simulated, whether
+    the end keeps the bird within its limits, and whether it reaches the
+    screen's goal (within them, and held long enough)."""
 
     start: np.ndarray
     d: np.ndarray
     value: Scored
     simulations: int
     within: bool
+    reached: bool
 
     def row(self, cap: float) -> dict:
         """What a case keeps of it (JSON), SI: the shortfall as
@@ -74,7 +79,8 @@ class Screened:
         failed, jammed, over = self.value.shortfall(cap)
         summary = self.value.run.summary
         return {"start": self.start.tolist(), "d": self.d.tolist(), "within": self.within,
-                "simulations": self.simulations, "failed_runs": failed, "jammed": jammed,
+                "reached": self.reached, "simulations": self.simulations,
+                "failed_runs": failed, "jammed": jammed,
                 "over_limit_N": over, "hold_time_s": self.value.hold,
                 "max_finger_force_N": self.value.peak,
                 "max_finger_force_finger": summary["max_finger_force_finger"],
@@ -82,48 +88,52 @@ class Screened:
 
 
 def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
-           start: np.ndarray, budget: int = SIMULATIONS, workers: int | None = None
-           ) -> Screened:
+           start: np.ndarray, budget: int = SIMULATIONS, beyond: float | None = None,
+           workers: int | None = None) -> Screened:
     """The pattern search on one ``bird`` (a population of one) from the
     scaled ``start`` under ``cap`` (N), ending at the first design within its
-    limits or after ``budget`` simulations (the start's included)."""
+    limits that holds it longer than ``beyond`` (s; None: any hold), or
+    after ``budget`` simulations (the start's included)."""
     start = np.asarray(start, float)
     pool = Pairs(bird, settings, settings.simulator, workers)
 
     def beats(a: Scored, b: Scored) -> bool:
         return better(a, b, cap, tolerance=0.0, band=HOLD_BAND)
 
-    def within(value: Scored) -> bool:
-        return value.within(cap)
+    def reached(value: Scored) -> bool:
+        return value.within(cap) and (beyond is None or value.hold > beyond + HOLD_BAND)
 
     with pool:
         first, = pool.score([start])
         found = compass(pool.score, start, first, beats, allowed_by(bird.space, rules),
-                        budget, enough=within)
-    return Screened(start, found.d, found.value, len(found.trials) + 1, within(found.value))
+                        budget, enough=reached)
+    return Screened(start, found.d, found.value, len(found.trials) + 1,
+                    found.value.within(cap), reached(found.value))
 
 
-def nearest(rows: list[dict]) -> int:
-    """The screen row nearest its limits (fewest failed runs, then jams,
-    then the least force over a limit), the first of equals."""
-    return min(range(len(rows)), key=lambda i: (rows[i]["failed_runs"], rows[i]["jammed"],
-                                                rows[i]["over_limit_N"], i))
+def best_row(rows: list[dict]) -> int:
+    """The best screen row in the search's order: within the limits first,
+    the longer hold; else the fewest failed runs, then jams, then the least
+    force over a limit; the first of equals."""
+    return min(range(len(rows)), key=lambda i: (
+        (0, -rows[i]["hold_time_s"], 0, 0, i) if rows[i]["within"] else
+        (1, rows[i]["failed_runs"], rows[i]["jammed"], rows[i]["over_limit_N"], i)))
 
 
 def unreached(population: Population, caps, settings: LoopSettings, rows: list[dict],
               bird: str) -> Outcome:
-    """The answer where no start of the screen reached the limits of
-    ``bird``: the design nearest them, simulated for every bird as the
+    """The answer where no start of the screen reached its goal for
+    ``bird``: the best start's design, simulated for every bird as the
     search simulates, its own simulation as the claim; ``search`` holds the
     screen's every start."""
     caps = np.broadcast_to(np.asarray(caps, float), (len(population.members),)).copy()
-    k = nearest(rows)
+    k = best_row(rows)
     best = score(population, np.array(rows[k]["d"]), settings, workers=None)
     out = Outcome(best, None, caps)
     source = "the feasibility screen's simulation (as the pattern search simulates)"
     out.claims = [(m.hold, source) for m in best.members]
     out.claim = best.hold, source
-    out.search = {"method": "feasibility screen", "bird": bird, "starts": rows, "nearest": k,
+    out.search = {"method": "feasibility screen", "bird": bird, "starts": rows, "best": k,
                   "simulations": sum(r["simulations"] for r in rows) + len(population.members),
                   "rtol": settings.simulator.rtol, "caps_N": caps.tolist()}
     return out
