@@ -5,6 +5,7 @@ its explicit Jacobian is CasADi's derivative of the same chain; and the
 design NLP calls it with each node's whole state (the rates set the
 friction), its time and the design."""
 
+import re
 from dataclasses import replace
 from pathlib import Path
 
@@ -211,3 +212,17 @@ def test_the_nlp_finger_on_the_belt_is_the_simulators(finger_5a_on_the_belt):
     f, r = state.force, state.point - np.array([inputs["state"][0], 0.0, inputs["state"][1]])
     expected = 2 * np.array([f[0], f[2], r[2] * f[0] - r[0] * f[2]])
     assert np.allclose(np.asarray(out).ravel(), expected, rtol=1e-9, atol=1e-9 * abs(f).max())
+
+
+def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget():
+    """The count of the belt continuations' rootfinder calls is the run's own
+    (the same on every machine): a budget below it stops the run, not ok,
+    saying where and why; the unlimited run goes to its end."""
+    setup, run = prefetch.result(ON_THE_BELT, on_the_belt)
+    assert run.summary["ok"]
+    stopped = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=1e-6),
+                             SPATIAL_NODES)
+    assert not stopped.summary["ok"]
+    assert re.search(r"Newton rootfinder \d+ times, over the budget of 1e-06 per simulated "
+                     r"second", stopped.summary["message"])
+    assert stopped.trajectory.records[-1].t < run.trajectory.records[-1].t

@@ -193,8 +193,9 @@ class BeltedContact:
     max_steps: int = 400
 
     def __init__(self):
-        #: Newton solves of the last :meth:`continued`
-        self.newton_iterations = 0
+        #: Newton solves of the last :meth:`continued`; rootfinder calls of
+        #: every call (where the chord method did not converge: the costly ones)
+        self.newton_iterations = self.newton_total = 0
         self._calls: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
@@ -330,6 +331,7 @@ class BeltedContact:
             state.z, q, state.inverse, self.tolerance, CHORD_ITERATIONS)
         if z is None:
             z = newton(state.z, q)[0].ravel()
+            self.newton_total += 1
         self.newton_iterations += 1
         post, resid = (v.ravel() for v in post(z, q))
         if not (np.isfinite(resid[0]) and resid[0] < 1e-8):

@@ -537,6 +537,13 @@ class FingerForces:
         return plane, FrictionLaw(mu=self.belt_friction, speed=FRICTION_SPEED,
                                   sliding_at_origin=-v0, sliding_gradient=-G)
 
+    @property
+    def newton_solves(self) -> int:
+        """The belt continuations' Newton rootfinder calls so far, every
+        finger's (the costly part of a run's contact work, where the chord
+        method did not converge): the same count on every machine."""
+        return sum(0 if m._belted is None else m._belted.newton_total for m in self.models)
+
     def ellipsoid(self, y: np.ndarray) -> Ellipsoid:
         b = self.bird
         return Ellipsoid(b.eta, b.lam, b.gamma, (y[0], 0.0, y[1]), y[2])

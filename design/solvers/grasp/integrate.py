@@ -72,6 +72,10 @@ class IntegratorSettings:
     #: accuracy targets stays under it, the thesis's own steps do not
     #: (``python -m benchmarks.grasp``'s bdf4 rows, docs/performance.md).
     max_local_error: float = 1e-3
+    #: ``adaptive``: a run whose belt continuations call their Newton
+    #: rootfinder more than this per simulated second stops, not ok (None: no
+    #: limit). Unlike ``max_wall_time``, the count is the same on every machine.
+    max_newton_solves: float | None = None
 
     def finer(self, factor: float = 4.0) -> "IntegratorSettings":
         """Settings at ``factor`` times finer resolution (a reference run)."""
@@ -360,6 +364,13 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 return traj
             traj.steps += 1
             if traj.over_budget(started, s.max_wall_time, t_old, t_end):
+                return traj
+            solves = grasp.fingers.newton_solves
+            if s.max_newton_solves is not None and solves > s.max_newton_solves * t_end:
+                traj.ok = False
+                traj.message = (f"stopped at t = {t_old:.4f} s: the belt continuations called "
+                                f"their Newton rootfinder {solves} times, over the budget of "
+                                f"{s.max_newton_solves:g} per simulated second")
                 return traj
             dense = stepper.dense_output()
             t_new, y_new = stepper.t, stepper.y.copy()

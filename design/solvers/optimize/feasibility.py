@@ -16,6 +16,8 @@ bird at all keeps it within its limits and holds nobody.
   design/solvers/optimize/multistart.py), comparing designs as the
   population's search does. Each start ends at the first design that
   reaches the goal above, or when its budget of simulations is spent.
+* Each simulation has a budget of contact work (:data:`NEWTON_SOLVES`):
+  one past it stops and counts as a failed run.
 * A design that reaches it starts the population's search.
 * If no start reaches one, the population's search is not run: the answer
   is each start's best, the best of them simulated for every bird. It is
@@ -26,7 +28,7 @@ bird at all keeps it within its limits and holds nobody.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -36,6 +38,13 @@ from design.solvers.optimize.transcription import Rules
 from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, better,
                                                    score)
 
+#: each screen simulation's budget of belt-continuation rootfinder calls per
+#: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
+#: at the baseline call it 100-500 times a second; a Sobol start can land on
+#: designs whose contact it cannot follow cheaply, and one such simulation
+#: ran for over ten minutes where seconds are usual. A run stopped by it is
+#: a failed run, the worst a design can be.
+NEWTON_SOLVES = 2000
 #: the screen's starts and each one's budget of simulations, by default:
 #: the baseline and three Sobol points, each given 16 simulations (its own
 #: and about one poll of eight variables at the first step)
@@ -95,7 +104,8 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
     limits that holds it longer than ``beyond`` (s; None: any hold), or
     after ``budget`` simulations (the start's included)."""
     start = np.asarray(start, float)
-    pool = Pairs(bird, settings, settings.simulator, workers)
+    pool = Pairs(bird, settings, replace(settings.simulator, max_newton_solves=NEWTON_SOLVES),
+                 workers)
 
     def beats(a: Scored, b: Scored) -> bool:
         return better(a, b, cap, tolerance=0.0, band=HOLD_BAND)
