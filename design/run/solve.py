@@ -40,7 +40,8 @@ from design.solvers.optimize.robustness import robustness_text
 from design.solvers.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
-from design.solvers.optimize.feasibility import hardest_bird, screen, unreached
+from design.solvers.optimize.feasibility import (hardest_bird, screen, unreached,
+                                                verification_budget)
 from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solvers.optimize.pattern_search import search
@@ -332,7 +333,8 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
         check.submit(case.key, population, outcome.best.d)
     say("verifying at 4x finer resolution")
     with outcome.profile.phase(VERIFICATION):
-        fine = verify(population, outcome.best.d, settings)
+        fine = verify(population, outcome.best.d, settings,
+                      max_newton_solves=verification_budget(outcome.search))
     entry = _entry(space, problem, outcome, fine, problem.caps[k])
     if kept is not None:
         kept.profiles[case.key], kept.fine[case.key] = outcome.profile, fine
@@ -391,8 +393,11 @@ def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, 
 
 
 def jams(scored: Scored) -> list[str]:
-    """Each bird's jam: why its grasp is a jam ("; "-joined), or ``none``."""
-    return ["; ".join(m.run.summary["jam"]) or "none" for m in scored.members]
+    """Each bird's jam: why its grasp is a jam ("; "-joined), ``none``, or
+    why its run ended early."""
+    return ["; ".join(m.run.summary["jam"]) or
+            ("none" if m.run.summary["ok"] else f"run ended early: {m.run.summary['message']}")
+            for m in scored.members]
 
 
 def design_loop(settings):
@@ -414,7 +419,8 @@ def _verified(population: Population, key: str, result: dict, settings, profile:
     fine = kept.fine.get(key) if kept else None
     if fine is None:
         with profile.phase(VERIFICATION):
-            fine = verify(population, np.array(result["d"]), settings)
+            fine = verify(population, np.array(result["d"]), settings, max_newton_solves=
+                          verification_budget(result["solver"]["search"]))
     return fine
 
 

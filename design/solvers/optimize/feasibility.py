@@ -40,11 +40,15 @@ from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored,
 
 #: each screen simulation's budget of belt-continuation rootfinder calls per
 #: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
-#: at the baseline call it 100-500 times a second; a Sobol start can land on
+#: at the baseline call it 90-500 times a second; a Sobol start can land on
 #: designs whose contact it cannot follow cheaply, and one such simulation
 #: ran for over ten minutes where seconds are usual. A run stopped by it is
 #: a failed run, the worst a design can be.
 NEWTON_SOLVES = 2000
+#: the same budget for the 4x finer verification of a screen's answer (four
+#: times the steps): an answer the screen could not improve fails its run
+#: anyway, and its verification must end
+VERIFY_NEWTON_SOLVES = 4 * NEWTON_SOLVES
 #: the screen's starts and each one's budget of simulations, by default:
 #: the baseline and three Sobol points, each given 16 simulations (its own
 #: and about one poll of eight variables at the first step)
@@ -104,8 +108,7 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
     limits that holds it longer than ``beyond`` (s; None: any hold), or
     after ``budget`` simulations (the start's included)."""
     start = np.asarray(start, float)
-    pool = Pairs(bird, settings, replace(settings.simulator, max_newton_solves=NEWTON_SOLVES),
-                 workers)
+    pool = Pairs(bird, settings, budgeted(settings.simulator), workers)
 
     def beats(a: Scored, b: Scored) -> bool:
         return better(a, b, cap, tolerance=0.0, band=HOLD_BAND)
@@ -138,7 +141,8 @@ def unreached(population: Population, caps, settings: LoopSettings, rows: list[d
     screen's every start."""
     caps = np.broadcast_to(np.asarray(caps, float), (len(population.members),)).copy()
     k = best_row(rows)
-    best = score(population, np.array(rows[k]["d"]), settings, workers=None)
+    best = score(population, np.array(rows[k]["d"]), settings, budgeted(settings.simulator),
+                 workers=None)
     out = Outcome(best, None, caps)
     source = "the feasibility screen's simulation (as the pattern search simulates)"
     out.claims = [(m.hold, source) for m in best.members]
@@ -148,3 +152,14 @@ def unreached(population: Population, caps, settings: LoopSettings, rows: list[d
                   "rtol": settings.simulator.rtol, "caps_N": caps.tolist()}
     return out
 
+
+def budgeted(simulator):
+    """The screen's simulator: the search's, with :data:`NEWTON_SOLVES`."""
+    return replace(simulator, max_newton_solves=NEWTON_SOLVES)
+
+
+def verification_budget(search: dict | None) -> float | None:
+    """The contact-work budget of a design's verification: the screen's
+    answer's (:data:`VERIFY_NEWTON_SOLVES`), none for a search's."""
+    return VERIFY_NEWTON_SOLVES if (search or {}).get("method") == "feasibility screen" \
+        else None

@@ -547,13 +547,16 @@ def certify(space: DesignSpace | Population, outcome: Outcome, settings: LoopSet
 
 
 def verify(space: DesignSpace | Population, d: np.ndarray, settings: LoopSettings,
-           factor: float = 4.0, workers: int | None = None) -> Scored:
+           factor: float = 4.0, workers: int | None = None,
+           max_newton_solves: float | None = None) -> Scored:
     """Re-simulate every bird at ``factor`` times the optimiser's resolution:
     steps no longer than its grid step / factor, tolerances tightened by
     factor^4; the birds in ``workers`` processes (None: one per core, at
-    most two)."""
+    most two); ``max_newton_solves``: the runs' budget of contact work
+    (IntegratorSettings; None: none)."""
     s = settings.simulator
-    fine = replace(s.finer(factor), max_step=min(s.max_step, settings.nlp.time_step) / factor)
+    fine = replace(s.finer(factor), max_step=min(s.max_step, settings.nlp.time_step) / factor,
+                   max_newton_solves=max_newton_solves)
     return score(population_of(space), d, settings, fine, workers)
 
 
