@@ -340,14 +340,14 @@ def population(path: Path, data: dict) -> list[str]:
     p = data.get("population")
     if p is None:
         return []
+    screen = p.get("screen")
     labels = {"baseline": "baseline", "single_bird_optimum": "mean bird's optimum",
-              "robust_optimum": "robust optimum"}
+              "robust_optimum": "the screen's best design" if screen else "robust optimum"}
     columns = {"bird": lambda r: r["bird"]}
     for key, words in labels.items():
         columns.update({f"{words}: hold (s)": lambda r, k=key: r[f"{k}_hold_time_s"],
                         f"{words}: peak (N)": lambda r, k=key: r[f"{k}_max_finger_force_N"],
                         f"{words}: jam": lambda r, k=key: r[f"{k}_jam"]})
-    screen = p.get("screen")
     simulated = f"{p['simulations']} simulations of the feasibility screen" if screen else \
         f"{p['simulations']} designs simulated for every bird"
     lines = [f"`{p['command']}`: {p['status']} in {p['wall_time_s']:.0f} s on {p['workers']} "
