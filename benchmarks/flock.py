@@ -34,6 +34,7 @@ import design  # noqa: F401  first: it sets one BLAS thread before numpy loads (
 
 from benchmarks.results_file import machine, write_results
 from design.api import solve
+from design.solvers.optimize.feasibility import answered
 
 ROOT = Path(__file__).resolve().parents[1]
 RESULTS = Path(__file__).parent / "results" / "flock.json"
@@ -51,7 +52,7 @@ def population_entry(result: dict) -> dict:
             f"{'jam' if b[f'{label}_jam'] != 'none' else 'no jam':>6s}" + " " * 15
             for label in labels))
     search = result["solver"]["search"]
-    screen = search if search["method"] == "feasibility screen" else None
+    screen = search if answered(search) else None
     if screen:
         print(f"\nfeasibility screen on {screen['bird']}: start, simulations, within limits, "
               f"jammed, hold (s), peak (N)")

@@ -323,3 +323,24 @@ def test_an_unreached_screen_says_what_it_looked_for_and_where_each_start_ended(
     assert ("start 0: hold 0.4400 s, peak 48.40 N, jammed; start 1: hold 0.0000 s, peak "
             "5.60 N; start 2: hold 0.5600 s, peak 76.90 N, over a limit") in text
     assert text.endswith("the design reported is start 1's, verified for every bird")
+
+
+def test_a_run_the_screen_answered_fails_even_where_its_design_verifies():
+    """The screen's best design may keep every limit (a bird never lifted)
+    and pass its verification: the run still fails, since no start held the
+    hardest bird longer than the baseline, and says so."""
+    from types import SimpleNamespace
+
+    from design.run.solve import FAILED, _status
+
+    row = {"start_index": 0, "hold_time_s": 0.0, "max_finger_force_N": 5.6, "within": True,
+           "jammed": 0, "simulations": 16, "beyond_s": 0.0}
+    best = SimpleNamespace()
+    outcome = SimpleNamespace(claim=(0.0, "the screen"), errors=[], every_nlp_failed=False,
+                              best=best, baseline=None, cap=19.6, caps=np.array([19.6]),
+                              search={"method": "feasibility screen", "bird": "b", "best": 0,
+                                      "starts": [row]})
+    fine = SimpleNamespace(within=lambda caps, tolerance: True)
+    status, message = _status(None, None, outcome, {"cap_tolerance": 0.01, "passed": True,
+                                                    "model_warnings": []}, fine, [])
+    assert status == FAILED and message.startswith("no design found that keeps b within")

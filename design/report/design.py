@@ -10,6 +10,7 @@ from design.report.grasp import (animation_section, grasp_figures, reproduce_sec
 from design.report.display import shown
 from design.report.page import Page
 from design.solvers.grasp.simulation import GraspRun
+from design.solvers.optimize.feasibility import answered
 from design.solvers.optimize.model_check import check_text
 from design.solvers.optimize.robustness import robustness_text
 from design.solvers.optimize.profile import profile_rows
@@ -142,7 +143,7 @@ def search_table(page: Page, solver: dict) -> None:
     """The pattern search's simulations, in order: the step (scaled), the
     variable moved, the simulated hold and peak, and whether it was taken."""
     s = solver["search"]
-    if s["method"] == "feasibility screen":
+    if answered(s):
         screen_table(page, s)
         return
     page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "

@@ -40,7 +40,7 @@ from design.solvers.optimize.robustness import robustness_text
 from design.solvers.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
-from design.solvers.optimize.feasibility import (hardest_bird, screen, unreached,
+from design.solvers.optimize.feasibility import (answered, hardest_bird, screen, unreached,
                                                 verification_budget)
 from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
@@ -214,8 +214,8 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
     if problem.population:
         comparison = population_comparison(
             space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
-        search = entries[0]["solver"]["search"] or {}
-        if search.get("method") == "feasibility screen":
+        search = entries[0]["solver"]["search"]
+        if answered(search):
             comparison["robust_optimum_is"] = (
                 f"the feasibility screen's best design for {search['bird']}: no start held "
                 f"it within its limits longer than the baseline, and the population's "
@@ -648,8 +648,8 @@ def _status(space, problem, outcome: Outcome, check, fine: Scored, variables
         return NO_IMPROVEMENT, ("the design loop found no design that holds longer under "
                                 "the cap; the design reported is the baseline, unchanged"
                                 + failures)
-    if (outcome.search or {}).get("method") == "feasibility screen":
-        return FAILED, _diagnosis(space, problem, outcome, variables)
+    if answered(outcome.search):
+        return FAILED, screen_diagnosis(outcome.search, outcome.cap)
     if check["passed"] and check["model_warnings"]:
         return VERIFIED, ("verified by a model outside its validity: the independent "
                           "simulation confirms the design, but the grasp model is outside "
@@ -678,9 +678,6 @@ def _diagnosis(space, problem, outcome: Outcome, variables) -> str:
     rules = [tag for margin, tag in rule_margins(values, space.baseline, problem.rules)
              if margin < 1e-6]
     stops = bounds + rules
-    search = outcome.search or {}
-    if search.get("method") == "feasibility screen":
-        return screen_diagnosis(search, cap)
     return (f"no design within the bounds keeps every finger under {cap:.2f} N{bird}: the "
             f"smallest peak force reached is {best.peaks[k]:.2f} N (finger "
             f"{run.summary['max_finger_force_finger']}); "

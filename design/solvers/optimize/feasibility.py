@@ -49,6 +49,8 @@ NEWTON_SOLVES = 2000
 #: times the steps): an answer the screen could not improve fails its run
 #: anyway, and its verification must end
 VERIFY_NEWTON_SOLVES = 4 * NEWTON_SOLVES
+#: ``solver.search.method`` of a run the screen answered
+METHOD = "feasibility screen"
 #: the screen's starts and each one's budget of simulations, by default:
 #: the baseline and three Sobol points, each given 16 simulations (its own
 #: and about one poll of eight variables at the first step)
@@ -147,7 +149,7 @@ def unreached(population: Population, caps, settings: LoopSettings, rows: list[d
     source = "the feasibility screen's simulation (as the pattern search simulates)"
     out.claims = [(m.hold, source) for m in best.members]
     out.claim = best.hold, source
-    out.search = {"method": "feasibility screen", "bird": bird, "starts": rows, "best": k,
+    out.search = {"method": METHOD, "bird": bird, "starts": rows, "best": k,
                   "simulations": sum(r["simulations"] for r in rows) + len(population.members),
                   "rtol": settings.simulator.rtol, "caps_N": caps.tolist()}
     return out
@@ -158,8 +160,12 @@ def budgeted(simulator):
     return replace(simulator, max_newton_solves=NEWTON_SOLVES)
 
 
+def answered(search: dict | None) -> bool:
+    """Did the screen answer the run whose ``solver.search`` this is?"""
+    return (search or {}).get("method") == METHOD
+
+
 def verification_budget(search: dict | None) -> float | None:
     """The contact-work budget of a design's verification: the screen's
     answer's (:data:`VERIFY_NEWTON_SOLVES`), none for a search's."""
-    return VERIFY_NEWTON_SOLVES if (search or {}).get("method") == "feasibility screen" \
-        else None
+    return VERIFY_NEWTON_SOLVES if answered(search) else None
