@@ -23,7 +23,9 @@ from design.solvers.optimize.feasibility import SIMULATIONS, STARTS, best_row, h
 from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.transcription import NLPSettings
-from design.run.solve import population_comparison
+from design.run.solve import _verified, per_bird, population_comparison
+from design.solvers.optimize.profile import Profile
+from design.solvers.optimize.variables import DesignSpace
 from design.solvers.optimize.trust_region import Scored, verify
 from tests import prefetch
 from tests.design_cases import (LOOP, sharing_simulations, short_problem_file,
@@ -190,7 +192,7 @@ def test_the_population_table_gives_each_designs_hold_peak_and_jam():
     robust.members[0].run.summary["jam"] = [reason]
     single = {"holds_s": [0.25], "peaks_N": [17.5], "jams": ["none"], "cap_N": 20.0,
               "design": {}}
-    table = population_comparison(space, Population.of(space), base, single, robust,
+    table = population_comparison(space, Population.of(space), base, single, per_bird(robust),
                                   np.array([20.0]))
     row, = table["birds"]
     assert row["baseline_jam"] == ("; ".join(base.run.summary["jam"]) or "none")
@@ -198,6 +200,27 @@ def test_the_population_table_gives_each_designs_hold_peak_and_jam():
     assert (row["single_bird_optimum_hold_time_s"], row["robust_optimum_hold_time_s"]) == \
         (0.25, base.hold)
     assert row["robust_optimum_max_finger_force_N"] == base.peak
+
+
+def test_a_case_run_elsewhere_has_its_limiting_birds_run_simulated_again():
+    """A case a worker ran leaves every bird's hold, peak and jam in its
+    result; this process simulates again only the bird whose run the
+    report shows, the one with the shortest hold (here the heavier bird,
+    listed second), and gets that bird's numbers (the runs are
+    deterministic)."""
+    space = stiffness_space("lower", hi=2.0)
+    heavy = replace(space.baseline.bird, mass=1.5 * space.baseline.bird.mass)
+    population = Population((Member("mean", space),
+                             Member("heavy", DesignSpace(replace(space.baseline, bird=heavy),
+                                                         space.variables))))
+    d = space.scale(space.base_values)
+    with sharing_simulations():
+        every = verify(population, d, LOOP)
+        result = {**per_bird(every), "d": d.tolist(), "solver": {"search": {}}}
+        again = _verified(population, "cap-1", result, LOOP, Profile(), None)
+    assert every.limiting == 1
+    assert again.population.members == (population.members[1],)
+    assert (again.hold, again.peak) == (every.holds[1], every.peaks[1])
 
 
 def _two_birds(caps_scale=(1.5, 1.5)):

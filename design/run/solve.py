@@ -181,23 +181,24 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
     if failed:
         raise StudyFailed("; ".join(f"case {k!r}: {r['status']}: {r.get('message', '')}"
                                     for k, r in failed.items()))
-    entries, finals = {}, {}
+    entries = {}
     for k in range(len(caps)):
         keys = [case.key for case in cases if case.inputs.get("cap_index") == k]
         best = max(keys, key=lambda key: _rank(results[key]))
-        entries[k] = dict(results[best], case=best)
+        entries[k] = {key: value for key, value in results[best].items()
+                      if key not in ("d", *PER_BIRD)} | {"case": best}
         if entries[k]["status"] == NO_DESIGN:
             entries[k]["status"] = ERROR
         if problem.multistart.starts > 1:
             entries[k]["multistart"] = multistart_summary(problem, space, keys, results)
-        finals[k] = _verified(population, best, results[best], settings, profile, kept)
-        entries[k].pop("d")
+    primary = results[entries[0]["case"]]
+    fine = _verified(population, entries[0]["case"], primary, settings, profile, kept)
     model_check, robust = None, None
     optimum = entries[0]["status"] in (VERIFIED, FAILED)        # else no optimum to check
     if problem.robustness and optimum:
-        check.submit_setups(ROBUST_OPTIMUM, robustness.scenes(space.setup(finals[0].d)))
+        check.submit_setups(ROBUST_OPTIMUM, robustness.scenes(space.setup(fine.d)))
     if problem.model_check != "none" and optimum:
-        check.submit(entries[0]["case"], population, finals[0].d)
+        check.submit(entries[0]["case"], population, fine.d)
         with profile.phase(MODEL_CHECK):
             model_check = check.result(population, problem.caps[0],
                                        optimum=entries[0]["case"])
@@ -206,14 +207,14 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
             robust = robustness.table(check.runs(ROBUST_BASELINE), check.runs(ROBUST_OPTIMUM),
                                       float(caps[0][0]))
     with profile.phase(RESULT):
-        output = _output(problem, space, [entries[k] for k in range(len(caps))], finals[0],
+        output = _output(problem, space, [entries[k] for k in range(len(caps))], fine,
                          baseline, t0, model_check)
     if robust is not None:
         output.result["robustness"] = robust
         output.tables["robustness.csv"] = robust["cases"]
     if problem.population:
         comparison = population_comparison(
-            space, population, baseline, results[SINGLE_BIRD], finals[0], caps[0])
+            space, population, baseline, results[SINGLE_BIRD], primary, caps[0])
         search = entries[0]["solver"]["search"]
         if answered(search):
             comparison["robust_optimum_is"] = (
@@ -342,7 +343,7 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     # a loop that could not work from this start is an answer, not a failed
     # case (the study engine's "error": the computation raised)
     status = NO_DESIGN if entry["status"] == ERROR else entry["status"]
-    return {**entry, "status": status, "d": outcome.best.d.tolist(),
+    return {**entry, **per_bird(fine), "status": status, "d": outcome.best.d.tolist(),
             "start_index": case.inputs["start_index"],
             "hold_time_s": v["hold_time_s"],
             "max_finger_force_N": v["max_finger_force_N"],
@@ -360,8 +361,7 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
     if kept is not None:
         kept.profiles[case.key] = outcome.profile
     return {"status": "done", "d": outcome.best.d.tolist(), "cap_N": float(cap),
-            "design": space.design(outcome.best.d), "holds_s": fine.holds.tolist(),
-            "peaks_N": fine.peaks.tolist(), "jams": jams(fine), "hold_time_s": fine.hold}
+            "design": space.design(outcome.best.d), **per_bird(fine), "hold_time_s": fine.hold}
 
 
 def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
@@ -392,6 +392,16 @@ def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, 
                                          np.array(reached[0]["d"]), progress, anchor=True)
 
 
+def per_bird(scored: Scored) -> dict:
+    """Each bird's hold (s), peak (N) and jam, in member order, as a case's
+    result carries them (:data:`PER_BIRD`)."""
+    return dict(zip(PER_BIRD, (scored.holds.tolist(), scored.peaks.tolist(), jams(scored))))
+
+
+#: the keys of :func:`per_bird`
+PER_BIRD = ("holds_s", "peaks_N", "jams")
+
+
 def jams(scored: Scored) -> list[str]:
     """Each bird's jam: why its grasp is a jam ("; "-joined), ``none``, or
     why its run ended early."""
@@ -415,11 +425,15 @@ def _rank(result: dict) -> tuple:
 def _verified(population: Population, key: str, result: dict, settings, profile: Profile,
               kept: Kept | None) -> Scored:
     """The 4x finer simulations of a case's design: the case's own if it
-    ran in this process, else simulated again (deterministic: the same)."""
+    ran in this process, else its limiting bird's (the report's run)
+    simulated again (deterministic: the same run); every bird's numbers are
+    in the case's result (:func:`per_bird`)."""
     fine = kept.fine.get(key) if kept else None
     if fine is None:
+        limiting = population.members[int(np.argmin(result["holds_s"]))]
         with profile.phase(VERIFICATION):
-            fine = verify(population, np.array(result["d"]), settings, max_newton_solves=
+            fine = verify(Population((limiting,), population.aggregate), np.array(result["d"]),
+                          settings, max_newton_solves=
                           verification_budget(result["solver"]["search"]))
     return fine
 
@@ -449,15 +463,16 @@ def multistart_summary(problem: DesignProblem, space: DesignSpace, keys: list[st
 
 
 def population_comparison(space: DesignSpace, population: Population, baseline: Scored,
-                          single: dict, fine: Scored, caps: np.ndarray) -> dict:
+                          single: dict, robust: dict, caps: np.ndarray) -> dict:
     """Each bird's hold, peak and jam under the baseline, the single-bird
-    optimum (the scene's own bird alone, at its cap) and the robust optimum,
-    all verified at 4x the optimiser's resolution."""
-    designs = {"baseline": (baseline.holds, baseline.peaks),
-               "single_bird_optimum": (np.array(single["holds_s"]), np.array(single["peaks_N"])),
-               "robust_optimum": (fine.holds, fine.peaks)}
-    jammed = {"baseline": jams(baseline), "single_bird_optimum": single["jams"],
-              "robust_optimum": jams(fine)}
+    optimum (the scene's own bird alone, at its cap) and the robust optimum
+    (their cases' :func:`per_bird`), all verified at 4x the optimiser's
+    resolution."""
+    each = {"baseline": per_bird(baseline), "single_bird_optimum": single,
+            "robust_optimum": robust}
+    designs = {label: (np.array(r["holds_s"]), np.array(r["peaks_N"]))
+               for label, r in each.items()}
+    jammed = {label: r["jams"] for label, r in each.items()}
     rows = [{"bird": member.name, "weight": float(population.weights[b]),
              "cap_N": float(caps[b]),
              **{f"{label}_{key}": float(values[i][b]) for label, values in designs.items()
