@@ -272,18 +272,18 @@ def _population_problem(tmp_path, screen=None):
 
 def test_a_baseline_that_breaks_a_birds_limits_is_screened_first(tmp_path):
     """The screen's starts (the baseline and Sobol points) are cases of their
-    own; the baseline start's cap needs every one of them; the single-bird
-    comparison comes first, to run beside them. A baseline within every
-    bird's limits is not screened."""
+    own, first; the baseline start's cap needs every one of them; the
+    single-bird comparison, which no case needs, comes last. A baseline
+    within every bird's limits is not screened."""
     from design.run.solve import SCREEN, SINGLE_BIRD, design_cases
 
     problem = _population_problem(tmp_path, {"starts": 3, "max_simulations": 5})
     two, caps = _two_birds()
     space = two.population.space
     cases = design_cases(problem, space, two.population, [caps * [1.0, 0.5]], two)
-    assert [c.key for c in cases] == [SINGLE_BIRD, f"{SCREEN}start-00", f"{SCREEN}start-01",
-                                      f"{SCREEN}start-02", "cap-1"]
-    screens, cap = cases[1:4], cases[-1]
+    assert [c.key for c in cases] == [f"{SCREEN}start-00", f"{SCREEN}start-01",
+                                      f"{SCREEN}start-02", "cap-1", SINGLE_BIRD]
+    screens, cap = cases[:3], cases[3]
     assert cap.after == tuple(c.key for c in screens) and cap.inputs["screened"]
     assert [c.inputs["bird_index"] for c in screens] == [1, 1, 1]
     assert [c.inputs["max_simulations"] for c in screens] == [5, 5, 5]
@@ -292,8 +292,8 @@ def test_a_baseline_that_breaks_a_birds_limits_is_screened_first(tmp_path):
     # the shortest hold is no longer than the screened bird's: it must beat the baseline's
     assert screens[0].inputs["beyond_s"] == two.hold
     plain = design_cases(problem, space, two.population, [caps], two)
-    assert [c.key for c in plain] == [SINGLE_BIRD, "cap-1"] and plain[-1].after is None
-    assert not plain[-1].inputs["screened"]
+    assert [c.key for c in plain] == ["cap-1", SINGLE_BIRD] and plain[0].after is None
+    assert not plain[0].inputs["screened"]
 
 
 def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(

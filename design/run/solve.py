@@ -264,10 +264,10 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
     d0 = space.scale(space.base_values)
     starts = starting_designs(d0, m.starts, m.seed)
     order = sorted(range(len(caps)), key=lambda k: caps[k][0])
-    cases, screens = [], []
+    cases, screens, single = [], [], []
     if problem.population:
-        cases.append(Case(SINGLE_BIRD, {"single_bird": space.baseline.bird.name,
-                                        "cap_N": float(caps[0][0])}))
+        single.append(Case(SINGLE_BIRD, {"single_bird": space.baseline.bird.name,
+                                         "cap_N": float(caps[0][0])}))
         b = hardest_bird(baseline, caps[order[0]], CAP_TOLERANCE)
         spec = problem.population
         if b is not None:
@@ -286,8 +286,9 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
                                     "caps_N": caps[k].tolist(),
                                     "screened": isinstance(after, tuple)}, after))
             after = key
-    # the single-bird comparison first: the longest case, it runs beside the screen
-    return cases[:1] + screens + cases[1:] if problem.population else cases
+    # the screen first, as the tightest cap waits for all of it; the
+    # single-bird comparison, which nothing waits for, last
+    return screens + cases + single
 
 
 def design_bird_peak(population: Population, space: DesignSpace, baseline: Scored,
