@@ -17,6 +17,8 @@ Fixed-step classical RK4: order 4 in the number of steps ``nodes``.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from design.physics.beam import BeamSolution, PointLoad, classify_branch
@@ -50,46 +52,48 @@ class Shooting(IterativeMethod):
         h = 1.0 / (nseg * per)
         # e(u) = EI_r / EI(uL) at every step's start, middle and end, per segment
         grid = np.arange(2 * nseg * per + 1) * (h / 2)
-        e_all = ei_ref / stiff.ei(grid * L)
+        e_all = (ei_ref / stiff.ei(grid * L)).tolist()
 
-        def e_at(seg: np.ndarray, i: int, half: int) -> np.ndarray:
-            return e_all[2 * (seg * per + i) + half]
+        def rates(y: tuple, e: float) -> tuple:
+            """(ψ, μ, Φ00, Φ01, Φ10, Φ11)': the ODE and its sensitivity Φ' = J Φ,
+            J = [[0, e], [-κ cos(ψ + α), 0]]."""
+            psi, mu, p00, p01, p10, p11 = y
+            c = -kappa * math.cos(psi + alpha)
+            return mu * e, -kappa * math.sin(psi + alpha), e * p10, e * p11, c * p00, c * p01
 
-        seg = np.arange(nseg)
+        def plus(y: tuple, a: float, k: tuple) -> tuple:
+            return tuple([yi + a * ki for yi, ki in zip(y, k)])
+
+        def segment(psi0: float, mu0: float, j: int, path: list | None) -> tuple:
+            """RK4 over segment j from (ψ, μ) = (psi0, mu0), Φ from the identity;
+            the states at each step appended to ``path``."""
+            y = (psi0, mu0, 1.0, 0.0, 0.0, 1.0)
+            for i in range(2 * j * per, 2 * (j + 1) * per, 2):
+                e0, e1, e2 = e_all[i], e_all[i + 1], e_all[i + 2]
+                k1 = rates(y, e0)
+                k2 = rates(plus(y, 0.5 * h, k1), e1)
+                k3 = rates(plus(y, 0.5 * h, k2), e1)
+                k4 = rates(plus(y, h, k3), e2)
+                y = tuple([a + h / 6 * (q1 + 2 * q2 + 2 * q3 + q4)
+                           for a, q1, q2, q3, q4 in zip(y, k1, k2, k3, k4)])
+                if path is not None:
+                    path.append(y[:2])
+            return y
 
         def shoot(psi0: np.ndarray, mu0: np.ndarray, record: bool = False):
-            """RK4 over every segment in parallel, with the 2x2 sensitivity."""
-            y = np.stack([psi0, mu0])                       # (2, S)
-            phi = np.broadcast_to(np.eye(2)[:, :, None], (2, 2, nseg)).copy()
-            path = [y.copy()] if record else None
-
-            def f(y, e):
-                return np.stack([y[1] * e, -kappa * np.sin(y[0] + alpha)])
-
-            def jf(y, e, ph):
-                # J = [[0, e], [-κ cos, 0]] applied to Φ (2, 2, S)
-                c = -kappa * np.cos(y[0] + alpha)
-                return np.stack([e * ph[1], c * ph[0]])
-
-            for i in range(per):
-                e0, e1, e2 = e_at(seg, i, 0), e_at(seg, i, 1), e_at(seg, i, 2)
-                k1, j1 = f(y, e0), jf(y, e0, phi)
-                y2, p2 = y + 0.5 * h * k1, phi + 0.5 * h * j1
-                k2, j2 = f(y2, e1), jf(y2, e1, p2)
-                y3, p3 = y + 0.5 * h * k2, phi + 0.5 * h * j2
-                k3, j3 = f(y3, e1), jf(y3, e1, p3)
-                y4, p4 = y + h * k3, phi + h * j3
-                k4, j4 = f(y4, e2), jf(y4, e2, p4)
-                y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-                phi = phi + h / 6 * (j1 + 2 * j2 + 2 * j3 + j4)
-                if record:
-                    path.append(y.copy())
-            return y, phi, path
+            """RK4 over every segment (each on its own: multiple shooting), with
+            the 2x2 sensitivity: the ends (2, S), Φ (2, 2, S) and, recorded,
+            the states (ψ, μ) at each step, (per + 1, 2, S)."""
+            paths = [[(p, m)] if record else None for p, m in zip(psi0, mu0)]
+            ends = np.array([segment(float(psi0[j]), float(mu0[j]), j, paths[j])
+                             for j in range(nseg)]).T           # (6, S)
+            path = np.array(paths).transpose(1, 2, 0) if record else None
+            return ends[:2], ends[2:].reshape(2, 2, nseg), path
 
         # unknowns: μ_0, then (ψ_j, μ_j) at the start of segments j = 1..S-1
-        u_starts = seg / nseg
-        psi_g, m_g = resample(guess, u_starts)
-        z = np.concatenate([[m_g[0] * L / ei_ref], np.stack([psi_g[1:], m_g[1:] * L / ei_ref], 1).ravel()])
+        psi_g, m_g = resample(guess, np.arange(nseg) / nseg)
+        z = np.concatenate([[m_g[0] * L / ei_ref],
+                            np.stack([psi_g[1:], m_g[1:] * L / ei_ref], 1).ravel()])
 
         def unpack(z):
             psi0 = np.concatenate([[0.0], z[1::2]])
@@ -119,8 +123,7 @@ class Shooting(IterativeMethod):
                             relative=True, residual_tolerance=1e-14 * max(1.0, kappa))
         z = res.x
         psi0, mu0 = unpack(z)
-        _, _, path = shoot(psi0, mu0, record=True)
-        traj = np.stack(path)                         # (per+1, 2, S)
+        _, _, traj = shoot(psi0, mu0, record=True)      # (per+1, 2, S)
         psi = np.concatenate([traj[:-1, 0, j] for j in range(nseg)] + [traj[-1:, 0, -1]])
         mu = np.concatenate([traj[:-1, 1, j] for j in range(nseg)] + [traj[-1:, 1, -1]])
         u = np.arange(psi.size) * h
