@@ -15,6 +15,7 @@ once per session, and those known before the first test starts
 from __future__ import annotations
 
 import contextlib
+import copy
 import dataclasses
 import functools
 import itertools
@@ -211,6 +212,18 @@ def sharing_simulations():
         for module in ("design.solvers.optimize.trust_region", "design.run.grasp"):
             patch.setattr(f"{module}.simulate_grasp", shared_simulate_grasp)
         yield
+
+
+def editable(scored):
+    """A copy of a simulated design whose runs' summaries and attributes a
+    test may change; the trajectories, which it does not, are shared (a
+    deep copy of a run takes about a second)."""
+    members = []
+    for member in scored.members:
+        run = copy.copy(member.run)
+        run.summary = copy.deepcopy(member.run.summary)
+        members.append(replace(member, run=run))
+    return replace(scored, members=members)
 
 
 #: the prefetch worker's key for :func:`single_bird_optimum` (tests/prefetch.py)

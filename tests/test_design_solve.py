@@ -7,7 +7,6 @@ loop simulation is computed once for the KKT, cap-continuation and
 exhaustive-search tests, and the verifications of the baseline and of the
 stiff design once for the verification test and ``design solve``'s."""
 
-import copy
 import json
 from dataclasses import replace
 
@@ -21,8 +20,9 @@ from design.solvers.optimize.transcription import DesignNLP
 from design.solvers.optimize.trust_region import (Outcome, better, optimise, score, simulate,
                                                 verdict, verify)
 from tests import prefetch
-from tests.design_cases import (LOOP, SINGLE_BIRD, sharing_simulations, short_problem_file,
-                                single_bird_nlp, single_bird_optimum, stiffness_space)
+from tests.design_cases import (LOOP, SINGLE_BIRD, editable, sharing_simulations,
+                                short_problem_file, single_bird_nlp, single_bird_optimum,
+                                stiffness_space)
 
 
 @pytest.fixture
@@ -125,7 +125,7 @@ def test_better_wants_a_gain_over_its_band_and_the_cap_within_its_tolerance(
     decides) and neither without it (the same excess: no winner)."""
     space = stiffness_space("lower", hi=2.0)
     base = verify(space, space.scale(space.base_values), LOOP)
-    longer = copy.deepcopy(base)
+    longer = editable(base)
     longer.members[0].run.summary["hold_time_s"] += 2e-4
     roomy = [100.0]
     assert base.within(roomy) and longer.hold == pytest.approx(base.hold + 2e-4)
@@ -149,7 +149,7 @@ def test_better_orders_jammed_designs_by_how_far_they_are_from_the_rules(shared_
     cap = [base.peak / 2]
 
     def variant(extra_force: float = 0.0, jam: bool = True, ok: bool = True):
-        v = copy.deepcopy(base)
+        v = editable(base)
         s = v.members[0].run.summary
         s["jam"] = list(s["jam"]) + (["the bird is still held off the belt when the run "
                                       "ends at 1.6 s (by 5b)"] if jam else [])

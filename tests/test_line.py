@@ -2,7 +2,6 @@
 spacing tied by eq. 5.3 (design/solvers/optimize/variables.py), the bird
 meeting its finger set as in the baseline scene."""
 
-import copy
 from dataclasses import replace
 from pathlib import Path
 
@@ -20,7 +19,7 @@ from design.solvers.optimize.line import broken, faster, included_angle, max_set
 from design.solvers.optimize.trust_region import verify
 from design.solvers.optimize.variables import (DesignSpace, Variable, parameters_of,
                                               synchronised, timed_conveyor)
-from tests.design_cases import LOOP, sharing_simulations, stiffness_space
+from tests.design_cases import LOOP, editable, sharing_simulations, stiffness_space
 
 SCENE = Path(__file__).resolve().parents[1] / "problems" / "grasp_mean_bird_hard_spatial.yaml"
 MODELS = SCENE.parents[1] / "models"
@@ -150,7 +149,7 @@ def test_more_sets_meet_the_bird_where_the_scene_does(baseline):
 
 def fake(base, drum_rpm: float, hold: float, extra_force: float = 0.0, jam: bool = False):
     """A copy of a simulated design with another drum speed, hold and peak."""
-    out = copy.deepcopy(base)
+    out = editable(base)
     run = out.members[0].run
     run.setup = replace(run.setup, drum_speed=drum_rpm * RPM)
     s = run.summary

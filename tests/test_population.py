@@ -10,7 +10,6 @@ in the scaled design and 1e-4 s in hold, against the 0.36-0.67 s holds and
 the [0, 1] box of the short grasp (tests/design_cases.py).
 """
 
-import copy
 import json
 from dataclasses import replace
 
@@ -27,7 +26,7 @@ from design.run.solve import _verified, per_bird, population_comparison
 from design.solvers.optimize.profile import Profile
 from design.solvers.optimize.trust_region import Scored, verify
 from tests import prefetch
-from tests.design_cases import (LOOP, sharing_simulations, short_problem_file,
+from tests.design_cases import (LOOP, editable, sharing_simulations, short_problem_file,
                                 single_bird_inputs, single_bird_optimum, stiffness_space)
 
 NLP = NLPSettings(time_step=0.01, max_iter=60)
@@ -186,7 +185,7 @@ def test_the_population_table_gives_each_designs_hold_peak_and_jam():
     space = stiffness_space("lower", hi=2.0)
     with sharing_simulations():
         base = verify(space, space.scale(space.base_values), LOOP)
-    robust = copy.deepcopy(base)
+    robust = editable(base)
     reason = "the bird is still held off the belt when the run ends at 1.000 s (by 5b)"
     robust.members[0].run.summary["jam"] = [reason]
     single = {"holds_s": [0.25], "peaks_N": [17.5], "jams": ["none"], "cap_N": 20.0,
@@ -224,7 +223,7 @@ def _two_birds(caps_scale=(1.5, 1.5)):
     space = stiffness_space("lower", hi=2.0)
     with sharing_simulations():
         base = verify(space, space.scale(space.base_values), LOOP)
-    members = [base.members[0], copy.deepcopy(base.members[0])]
+    members = [base.members[0], editable(base).members[0]]
     two = Scored(base.d, members, Population((Member("a", space), Member("b", space))))
     return two, base.peak * np.asarray(caps_scale)
 
