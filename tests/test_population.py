@@ -18,7 +18,9 @@ import pytest
 
 from design.io.scene import load_scene
 from design.errors import ProblemFileError
-from design.solvers.optimize.feasibility import SIMULATIONS, STARTS, best_row, hardest_bird
+from design.solvers.optimize.feasibility import (SIMULATIONS, STARTS, best_row, hardest_bird,
+                                                  nearer)
+from design.solvers.optimize.pattern_search import HOLD_BAND
 from design.solvers.optimize.multistart import SAME_DESIGN, distinct_optima, starting_designs
 from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.transcription import NLPSettings
@@ -242,17 +244,26 @@ def test_the_screen_takes_the_bird_furthest_from_its_limits():
     assert hardest_bird(two, caps * [0.5, 1.0], 0.0) == 1
 
 
-def test_the_best_screen_row_is_within_limits_then_nearest_them():
-    """Within the limits, the longer hold; else fewest failed runs, then
-    jams, then the least force over a limit; the first of equals."""
-    def row(within, hold, failed=0, jammed=0, over=-1.0):
-        return {"within": within, "hold_time_s": hold, "failed_runs": failed,
-                "jammed": jammed, "over_limit_N": over}
-    rows = [row(False, 0.5, jammed=1, over=1.0), row(False, 0.4, over=30.0),
-            row(False, 0.3, over=12.0), row(False, 0.0, failed=1, over=0.0),
-            row(False, 0.3, over=12.0)]
+def test_the_screen_ranks_designs_by_their_distance_from_its_goal():
+    """Fewest failed runs, then jams, then a hold beyond the baseline's
+    worst, then the least force over a limit (none within them), then the
+    longer hold; the first of equals. A design that keeps the bird within
+    its limits by never lifting it is not nearer the goal than one that
+    lifts it and presses too hard. Forces within 1 mN and holds within the
+    search's band are equal."""
+    def row(hold, failed=0, jammed=0, over=-1.0):
+        return {"hold_time_s": hold, "failed_runs": failed, "jammed": jammed,
+                "over_limit_N": over, "beyond_s": 0.05}
+    rows = [row(0.5, jammed=1, over=1.0), row(0.4, over=30.0), row(0.3, over=12.0),
+            row(0.0, failed=1, over=0.0), row(0.3, over=12.0)]
     assert best_row(rows) == 2
-    assert best_row(rows + [row(True, 0.0), row(True, 0.1), row(True, 0.1)]) == 6
+    never_lifted = row(0.0, over=-5.0)
+    assert best_row(rows + [never_lifted]) == 2
+    assert best_row(rows + [never_lifted, row(0.1), row(0.1)]) == 6
+    assert best_row([{**r, "beyond_s": None} for r in rows + [never_lifted]]) == 5
+    assert nearer((0, 0, False, 0.0, -0.10), (0, 0, False, 5e-4, -0.09))
+    assert not nearer((0, 0, False, 0.0, -0.10), (0, 0, False, 5e-4, -0.10 + HOLD_BAND / 2))
+    assert nearer((0, 0, False, 0.0, -0.10), (0, 0, False, 2e-3, -0.30))
 
 
 def _population_problem(tmp_path, screen=None):

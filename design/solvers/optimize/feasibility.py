@@ -13,9 +13,11 @@ bird at all keeps it within its limits and holds nobody.
 
 * The pattern search runs on that bird alone, from each of several starts
   (the baseline and points of a scrambled Sobol sequence, as a multistart's:
-  design/solvers/optimize/multistart.py), comparing designs as the
-  population's search does. Each start ends at the first design that
-  reaches the goal above, or when its budget of simulations is spent.
+  design/solvers/optimize/multistart.py), comparing designs by their
+  distance from the goal (:func:`distance`): a design that lifts the bird
+  and presses too hard is nearer than one that keeps its limits by never
+  lifting it. Each start ends at the first design that reaches the goal, or
+  when its budget of simulations is spent.
 * Each simulation has a budget of contact work (:data:`NEWTON_SOLVES`):
   one past it stops and counts as a failed run.
 * A design that reaches it starts the population's search.
@@ -35,8 +37,7 @@ import numpy as np
 from design.solvers.optimize.pattern_search import HOLD_BAND, Pairs, allowed_by, compass
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.transcription import Rules
-from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, better,
-                                                   score)
+from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, score)
 
 #: each screen simulation's budget of belt-continuation rootfinder calls per
 #: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
@@ -113,10 +114,11 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
     pool = Pairs(bird, settings, budgeted(settings.simulator), workers)
 
     def beats(a: Scored, b: Scored) -> bool:
-        return better(a, b, cap, tolerance=0.0, band=HOLD_BAND)
+        return nearer(distance(*a.shortfall(cap), a.hold, beyond),
+                      distance(*b.shortfall(cap), b.hold, beyond))
 
     def reached(value: Scored) -> bool:
-        return value.within(cap) and (beyond is None or value.hold > beyond + HOLD_BAND)
+        return value.within(cap) and holds_beyond(value.hold, beyond)
 
     with pool:
         first, = pool.score([start])
@@ -126,13 +128,39 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
                     found.value.within(cap), reached(found.value))
 
 
+def holds_beyond(hold: float, beyond: float | None) -> bool:
+    """Does a hold (s) count towards the screen's goal: longer than
+    ``beyond`` by more than the search's band (None: any hold)?"""
+    return beyond is None or hold > beyond + HOLD_BAND
+
+
+def distance(failed: int, jammed: int, over: float, hold: float, beyond: float | None) -> tuple:
+    """How far a design is from the screen's goal, in the order the screen
+    compares designs: failed runs, jammed birds, whether it fails to hold
+    the bird beyond ``beyond``, the force over a limit (N; none within
+    them), then the shorter hold (s, negated). A design that keeps the
+    bird within its limits by never lifting it is no nearer to holding it
+    than one that lifts it and presses too hard: the screen asks for both.
+    ``failed, jammed, over``: :meth:`Scored.shortfall`'s."""
+    return failed, jammed, not holds_beyond(hold, beyond), max(over, 0.0), -hold
+
+
+def nearer(a: tuple, b: tuple) -> bool:
+    """Is distance ``a`` nearer the goal than ``b``: the counts and the hold
+    flag exactly, the force over a limit by more than 1 mN, the hold by more
+    than the search's band, as the search compares."""
+    if a[:3] != b[:3]:
+        return a[:3] < b[:3]
+    if abs(a[3] - b[3]) > 1e-3:
+        return a[3] < b[3]
+    return a[4] < b[4] - HOLD_BAND
+
+
 def best_row(rows: list[dict]) -> int:
-    """The best screen row in the search's order: within the limits first,
-    the longer hold; else the fewest failed runs, then jams, then the least
-    force over a limit; the first of equals."""
-    return min(range(len(rows)), key=lambda i: (
-        (0, -rows[i]["hold_time_s"], 0, 0, i) if rows[i]["within"] else
-        (1, rows[i]["failed_runs"], rows[i]["jammed"], rows[i]["over_limit_N"], i)))
+    """The screen row nearest its goal (:func:`distance`), the first of equals."""
+    return min(range(len(rows)), key=lambda i: (distance(
+        rows[i]["failed_runs"], rows[i]["jammed"], rows[i]["over_limit_N"],
+        rows[i]["hold_time_s"], rows[i]["beyond_s"]), i))
 
 
 def unreached(population: Population, caps, settings: LoopSettings, rows: list[dict],
