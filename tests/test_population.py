@@ -266,6 +266,58 @@ def test_the_screen_ranks_designs_by_their_distance_from_its_goal():
     assert nearer((0, 0, False, 0.0, -0.10), (0, 0, False, 2e-3, -0.30))
 
 
+def test_the_screen_searches_for_a_lifted_bird_within_its_limits(monkeypatch):
+    """The screen's search prefers a design that lifts the bird and presses
+    too hard to one that keeps the limits by never lifting it, and stops
+    only at one that does both (its search and simulations faked: designs
+    given by their hold and force over a limit)."""
+    from types import SimpleNamespace
+
+    from design.solvers.optimize import feasibility
+
+    class Design:
+        def __init__(self, hold, over):
+            self.hold, self.over = hold, over
+
+        def shortfall(self, cap):
+            return 0, 0, self.over
+
+        def within(self, cap):
+            return self.over <= 0.0
+
+    class Pool:
+        def __init__(self, *args):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def score(self, designs):
+            return [Design(0.0, -5.0) for _ in designs]
+
+    seen = {}
+
+    def compass(evaluate, start, first, beats, allowed, budget, enough):
+        seen.update(beats=beats, enough=enough)
+        return SimpleNamespace(d=start, value=first, trials=[])
+
+    monkeypatch.setattr(feasibility, "Pairs", Pool)
+    monkeypatch.setattr(feasibility, "compass", compass)
+    monkeypatch.setattr(feasibility, "allowed_by", lambda space, rules: None)
+    space = stiffness_space("lower")
+    found = feasibility.screen(Population.of(space), 19.6, LOOP, None,
+                               space.scale(space.base_values), 16, beyond=0.05)
+    pressed, never_lifted, held = Design(0.09, 0.8), Design(0.0, -5.0), Design(0.09, -0.2)
+    beats, enough = seen["beats"], seen["enough"]
+    assert beats(pressed, never_lifted) and not beats(never_lifted, pressed)
+    assert beats(held, pressed) and beats(Design(0.09, 0.5), pressed)
+    assert [enough(d) for d in (pressed, never_lifted, held)] == [False, False, True]
+    assert (found.within, found.reached, found.simulations) == (True, False, 1)
+
+
 def _population_problem(tmp_path, screen=None):
     path = short_problem_file(tmp_path / "p.yaml", {"groups.lower.stiffness_scale": [0.5, 2.0]})
     data = json.loads(path.read_text())
