@@ -279,10 +279,10 @@ def test_the_screen_searches_for_a_lifted_bird_within_its_limits(monkeypatch):
         def __init__(self, hold, over):
             self.hold, self.over = hold, over
 
-        def shortfall(self, cap):
+        def shortfall(self, cap, tolerance=0.0):
             return 0, 0, self.over
 
-        def within(self, cap):
+        def within(self, cap, tolerance=0.0):
             return self.over <= 0.0
 
     class Pool:
