@@ -180,6 +180,10 @@ def test_a_hairline_graze_is_a_touch_without_force():
     x_c = finger.length * (100.5 / 200)              # midway between grid points
     quadric = Quadric(np.array([x_c, 0.0, r - 1e-9]), np.eye(3) / r ** 2)
     assert quadric.level(np.array([[x_c], [0.0], [0.0]]))[0] < 0
-    sol, state = SpatialContact(finger).solve(quadric)
+    solver = SpatialContact(finger)
+    sol, state = solver.solve(quadric)
     assert sol.converged and not sol.contact and state is None
     assert np.all(sol.force == 0.0) and "grazes" in sol.message
+    # an accepted instant's detail (a grasp commits its last trial so) adds nothing to it
+    detailed, kept = solver.detailed(sol, state)
+    assert detailed is sol and kept is None

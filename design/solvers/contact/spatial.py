@@ -288,12 +288,16 @@ class SpatialContact:
         sol.extras["friction_held"] = held
         return self.detailed(sol, state) if detail else (sol, state)
 
-    def detailed(self, sol: SpatialSolution, state: SpatialState
-                 ) -> tuple[SpatialSolution, SpatialState]:
+    def detailed(self, sol: SpatialSolution, state: SpatialState | None
+                 ) -> tuple[SpatialSolution, SpatialState | None]:
         """What an accepted instant keeps of a solve without detail: the
         solution with the finger's shape (a finger that passes into the
         object away from the contact is not converged), and the state with
-        its Jacobian inverse, to continue from by the chord method."""
+        its Jacobian inverse, to continue from by the chord method. A solve
+        that ended without a state (no contact: a graze, a finger that left
+        the bird) has nothing to add."""
+        if state is None:
+            return sol, None
         tr = self.tr[state.mode]
         q = self._params(state.quadric, state.friction)
         post = state.post
