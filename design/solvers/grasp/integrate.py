@@ -365,8 +365,8 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
             traj.steps += 1
             if traj.over_budget(started, s.max_wall_time, t_old, t_end):
                 return traj
-            solves = grasp.fingers.newton_solves
-            if s.max_newton_solves is not None and solves > s.max_newton_solves * t_end:
+            if s.max_newton_solves is not None and \
+                    (solves := grasp.fingers.newton_solves) > s.max_newton_solves * t_end:
                 traj.ok = False
                 traj.message = (f"stopped at t = {t_old:.4f} s: the belt continuations called "
                                 f"their Newton rootfinder {solves} times, over the budget of "

@@ -37,7 +37,8 @@ import numpy as np
 from design.solvers.optimize.pattern_search import HOLD_BAND, Pairs, allowed_by, compass
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.transcription import Rules
-from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, score)
+from design.solvers.optimize.trust_region import (FORCE_BAND, LoopSettings, Outcome, Scored,
+                                                   score)
 
 #: each screen simulation's budget of belt-continuation rootfinder calls per
 #: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
@@ -147,11 +148,12 @@ def distance(failed: int, jammed: int, over: float, hold: float, beyond: float |
 
 def nearer(a: tuple, b: tuple) -> bool:
     """Is distance ``a`` nearer the goal than ``b``: the counts and the hold
-    flag exactly, the force over a limit by more than 1 mN, the hold by more
-    than the search's band, as the search compares."""
+    flag exactly, the force over a limit by more than :data:`FORCE_BAND`, the
+    hold by more than the search's band, as
+    :func:`~design.solvers.optimize.trust_region.better` compares."""
     if a[:3] != b[:3]:
         return a[:3] < b[:3]
-    if abs(a[3] - b[3]) > 1e-3:
+    if abs(a[3] - b[3]) > FORCE_BAND:
         return a[3] < b[3]
     return a[4] < b[4] - HOLD_BAND
 

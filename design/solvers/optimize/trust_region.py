@@ -267,6 +267,10 @@ def score(population: Population, d: np.ndarray, settings: LoopSettings,
                              population.members, workers), population)
 
 
+#: forces over a limit (N) closer than this are equal when designs are compared
+FORCE_BAND = 1e-3
+
+
 def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
            band: float = 1e-5) -> bool:
     """Is a better than b: feasible (every bird under its cap, every finger
@@ -285,7 +289,7 @@ def better(a: Scored, b: Scored, caps, tolerance: float = CAP_TOLERANCE,
     (fail_a, jam_a, over_a), (fail_b, jam_b, over_b) = a.shortfall(caps), b.shortfall(caps)
     if (fail_a, jam_a) != (fail_b, jam_b):
         return (fail_a, jam_a) < (fail_b, jam_b)
-    return over_a < over_b - 1e-3
+    return over_a < over_b - FORCE_BAND
 
 
 def check_baseline(population: Population, baseline: Scored) -> None:
