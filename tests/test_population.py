@@ -328,26 +328,25 @@ def _population_problem(tmp_path, screen=None):
 
 
 def test_a_baseline_that_breaks_a_birds_limits_is_screened_first(tmp_path):
-    """The screen's starts (the baseline and Sobol points) are cases of their
-    own, first; the baseline start's cap needs every one of them; the
-    single-bird comparison, which no case needs, comes last. A baseline
-    within every bird's limits is not screened."""
+    """The screen (its starts the baseline and Sobol points) is a case of its
+    own, first; the baseline start's cap needs it; the single-bird
+    comparison, which no case needs, comes last. A baseline within every
+    bird's limits is not screened."""
     from design.run.solve import SCREEN, SINGLE_BIRD, design_cases
 
     problem = _population_problem(tmp_path, {"starts": 3, "max_simulations": 5})
     two, caps = _two_birds()
     space = two.population.space
     cases = design_cases(problem, space, two.population, [caps * [1.0, 0.5]], two)
-    assert [c.key for c in cases] == [f"{SCREEN}start-00", f"{SCREEN}start-01",
-                                      f"{SCREEN}start-02", "cap-1", SINGLE_BIRD]
-    screens, cap = cases[:3], cases[3]
-    assert cap.after == tuple(c.key for c in screens) and cap.inputs["screened"]
-    assert [c.inputs["bird_index"] for c in screens] == [1, 1, 1]
-    assert [c.inputs["max_simulations"] for c in screens] == [5, 5, 5]
-    assert screens[0].inputs["start"] == space.scale(space.base_values).tolist()
-    assert screens[0].inputs["cap_N"] == pytest.approx(caps[1] * 0.5)
+    assert [c.key for c in cases] == [SCREEN, "cap-1", SINGLE_BIRD]
+    screened, cap = cases[:2]
+    assert cap.after == SCREEN and cap.inputs["screened"]
+    assert screened.inputs["bird_index"] == 1 and screened.inputs["max_simulations"] == 5
+    assert len(screened.inputs["starts"]) == 3
+    assert screened.inputs["starts"][0] == space.scale(space.base_values).tolist()
+    assert screened.inputs["cap_N"] == pytest.approx(caps[1] * 0.5)
     # the shortest hold is no longer than the screened bird's: it must beat the baseline's
-    assert screens[0].inputs["beyond_s"] == two.hold
+    assert screened.inputs["beyond_s"] == two.hold
     plain = design_cases(problem, space, two.population, [caps], two)
     assert [c.key for c in plain] == ["cap-1", SINGLE_BIRD] and plain[0].after is None
     assert not plain[0].inputs["screened"]
@@ -367,13 +366,53 @@ def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(
     monkeypatch.setattr(solve, "unreached", lambda population, caps, settings, rows, bird:
                         calls.append(("unreached", [r["d"] for r in rows], bird)) or "nearest")
     row = {"bird": "large-bird-2.30kg", "reached": False, "d": [0.1]}
-    rows = {"s0": row, "s1": {**row, "reached": True, "d": [0.7]},
-            "s2": {**row, "reached": True, "d": [0.9]}}
-    assert solve._screened(problem, None, np.ones(2), None, rows, None) == "searched"
+    rows = [row, {**row, "reached": True, "d": [0.7]}]
+    assert solve._screened(problem, None, np.ones(2), None, {"rows": rows}, None) == "searched"
     assert calls[-1][0] == "search" and calls[-1][1].tolist() == [0.7] and calls[-1][2]
-    missed = {k: {**r, "reached": False} for k, r in rows.items()}
-    assert solve._screened(problem, None, np.ones(2), None, missed, None) == "nearest"
+    missed = [row, {**row, "d": [0.7]}, {**row, "d": [0.9]}]
+    assert solve._screened(problem, None, np.ones(2), None, {"rows": missed}, None) == "nearest"
     assert calls[-1] == ("unreached", [[0.1], [0.7], [0.9]], "large-bird-2.30kg")
+
+
+def test_the_screen_tries_its_starts_in_turn_until_one_reaches_its_goal(tmp_path, monkeypatch):
+    """The screen runs the starts in order and ends at the first that
+    reaches its goal (the later ones cannot change where the population's
+    search starts); where none reaches it, every start runs, and the case
+    reports the nearest one's hold and peak."""
+    from types import SimpleNamespace
+
+    from design.run import solve
+    from design.study.cases import Case
+
+    problem = _population_problem(tmp_path)
+    two, _ = _two_birds()
+    tried = []
+
+    def fake_screen(reaching):
+        def run(bird, cap, settings, rules, start, budget, beyond):
+            tried.append(start[0])
+            k = int(start[0])
+            value = SimpleNamespace(hold=0.1 * k, peak=30.0 - k)
+            return SimpleNamespace(d=start, reached=k == reaching, row=lambda cap: {
+                "d": start.tolist(), "reached": k == reaching, "failed_runs": 0, "jammed": 0,
+                "over_limit_N": 0.0 if k == reaching else 10.0 - k, "hold_time_s": value.hold,
+                "max_finger_force_N": value.peak})
+        return run
+
+    case = Case(solve.SCREEN, {"bird": "b", "bird_index": 1, "cap_N": 20.0,
+                               "starts": [[0.0], [1.0], [2.0], [3.0]], "max_simulations": 4,
+                               "beyond_s": None})
+    monkeypatch.setattr(solve.DesignSpace, "design", lambda self, d: {"x": d[0]})
+    monkeypatch.setattr(solve, "screen", fake_screen(reaching=1))
+    result = solve._screen(problem, two.population, case)
+    assert tried == [0.0, 1.0] and [r["start_index"] for r in result["rows"]] == [0, 1]
+    assert result["rows"][-1]["reached"] and result["hold_time_s"] == pytest.approx(0.1)
+    tried.clear()
+    monkeypatch.setattr(solve, "screen", fake_screen(reaching=None))
+    result = solve._screen(problem, two.population, case)
+    assert tried == [0.0, 1.0, 2.0, 3.0] and not any(r["reached"] for r in result["rows"])
+    # the nearest: the least force over a limit (start 3's 7 N)
+    assert result["max_finger_force_N"] == 27.0
 
 
 def test_screen_settings_are_read_and_checked(tmp_path):

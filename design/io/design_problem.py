@@ -17,6 +17,7 @@ bounds, the bruise cap, the design rules and the solver settings.
       birds: [models/birds/small_1_20kg.yaml, {bird: models/birds/large_2_30kg.yaml, weight: 2}]
       screen: {starts: 4, max_simulations: 16}   # where the baseline breaks a bird's limits:
                                # the pattern search on the hardest bird alone from each start
+                               # in turn, until one reaches its goal
                                # (design/solvers/optimize/feasibility.py); the defaults
     multistart: {starts: 8, seed: 0}   # optional: the loop from the baseline and 7 Sobol points
     model_check: spatial       # the default: baseline and optimum also run with the spatial

@@ -40,8 +40,8 @@ from design.solvers.optimize.robustness import robustness_text
 from design.solvers.optimize.model_check import BASELINE, ModelCheck, check_text
 from design.solvers.optimize.profile import (CASE_OVERHEAD, MODEL_CHECK, RESULT, ROBUSTNESS,
                                            SETUP, STUDY, VERIFICATION, Profile, clocks)
-from design.solvers.optimize.feasibility import (answered, hardest_bird, screen, unreached,
-                                                verification_budget)
+from design.solvers.optimize.feasibility import (answered, best_row, hardest_bird, screen,
+                                                unreached, verification_budget)
 from design.solvers.optimize.multistart import (SAME_DESIGN, SAME_HOLD, distinct_optima,
                                               starting_designs)
 from design.solvers.optimize.pattern_search import search
@@ -238,8 +238,8 @@ NO_DESIGN = "no design (optimiser error)"
 ROBUST_BASELINE, ROBUST_OPTIMUM = "robustness: baseline", "robustness: optimum"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
-#: the prefix of a population's feasibility screen's cases
-SCREEN = "screen/"
+#: the study's case for a population's feasibility screen
+SCREEN = "screen"
 
 
 @dataclass
@@ -258,13 +258,14 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
     for the next, looser cap and warm-starts it, so that the hold cannot fall
     as the cap rises), and a population's single-bird comparison. Where the
     (verified) ``baseline`` breaks a bird's limits at the tightest cap, the
-    feasibility screen's starts come first: the baseline start's tightest
-    cap needs them all (design/solvers/optimize/feasibility.py)."""
+    feasibility screen comes first, one case trying its starts in turn: the
+    baseline start's tightest cap needs it
+    (design/solvers/optimize/feasibility.py)."""
     m = problem.multistart
     d0 = space.scale(space.base_values)
     starts = starting_designs(d0, m.starts, m.seed)
     order = sorted(range(len(caps)), key=lambda k: caps[k][0])
-    cases, screens, single = [], [], []
+    cases, screened, single = [], [], []
     if problem.population:
         single.append(Case(SINGLE_BIRD, {"single_bird": space.baseline.bird.name,
                                          "cap_N": float(caps[0][0])}))
@@ -273,22 +274,22 @@ def design_cases(problem: DesignProblem, space: DesignSpace, population: Populat
         if b is not None:
             # the shortest hold is no longer than this bird's: it must beat the baseline's
             beyond = baseline.hold if population.aggregate == "worst" else None
-            for s, d in enumerate(starting_designs(d0, spec.screen_starts, m.seed)):
-                screens.append(Case(f"{SCREEN}start-{s:02d}", {
-                    "bird": population.members[b].name, "bird_index": b, "start": d.tolist(),
-                    "start_index": s, "cap_N": float(caps[order[0]][b]),
-                    "max_simulations": spec.screen_simulations, "beyond_s": beyond}))
+            screened.append(Case(SCREEN, {
+                "bird": population.members[b].name, "bird_index": b,
+                "starts": [d.tolist() for d in starting_designs(d0, spec.screen_starts, m.seed)],
+                "cap_N": float(caps[order[0]][b]), "max_simulations": spec.screen_simulations,
+                "beyond_s": beyond}))
     for s, d in enumerate(starts):
-        after = tuple(c.key for c in screens) if s == 0 and screens else None
+        after = SCREEN if s == 0 and screened else None
         for k in order:
             key = f"start-{s:02d}/cap-{k + 1}" if m.starts > 1 else f"cap-{k + 1}"
             cases.append(Case(key, {"start": d.tolist(), "start_index": s, "cap_index": k,
                                     "caps_N": caps[k].tolist(),
-                                    "screened": isinstance(after, tuple)}, after))
+                                    "screened": after == SCREEN}, after))
             after = key
-    # the screen first, as the tightest cap waits for all of it; the
-    # single-bird comparison, which nothing waits for, last
-    return screens + cases + single
+    # the screen first, as the tightest cap waits for it; the single-bird
+    # comparison, which nothing waits for, last
+    return screened + cases + single
 
 
 def design_bird_peak(population: Population, space: DesignSpace, baseline: Scored,
@@ -316,7 +317,7 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     settings = problem.settings
     if case.key == SINGLE_BIRD:
         return _single_bird(problem, space, population, case, kept)
-    if case.key.startswith(SCREEN):
+    if case.key == SCREEN:
         return _screen(problem, population, case)
     k = case.inputs["cap_index"]
     caps = np.array(case.inputs["caps_N"])
@@ -366,24 +367,33 @@ def _single_bird(problem: DesignProblem, space: DesignSpace, population: Populat
 
 
 def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
-    """One start of the feasibility screen: the pattern search on the hardest
-    bird alone, ended at the first design that reaches its goal."""
-    b = case.inputs["bird_index"]
-    found = screen(Population((population.members[b],)), case.inputs["cap_N"],
-                   problem.settings, problem.rules, np.array(case.inputs["start"]),
-                   case.inputs["max_simulations"], case.inputs["beyond_s"])
-    return {"status": "done", "verified": False, "bird": case.inputs["bird"],
-            "start_index": case.inputs["start_index"], "beyond_s": case.inputs["beyond_s"],
-            **found.row(case.inputs["cap_N"]),
-            "design": population.space.design(found.d)}
+    """The feasibility screen: the pattern search on the hardest bird alone
+    from each start in turn, each ended at the first design that reaches the
+    screen's goal; the starts after the first that reaches it are not run
+    (the population's search starts from that one). The result's ``rows``
+    are the starts run; its hold and peak, the nearest one's."""
+    inputs, b = case.inputs, case.inputs["bird_index"]
+    bird = Population((population.members[b],))
+    rows = []
+    for s, start in enumerate(inputs["starts"]):
+        found = screen(bird, inputs["cap_N"], problem.settings, problem.rules, np.array(start),
+                       inputs["max_simulations"], inputs["beyond_s"])
+        rows.append({"bird": inputs["bird"], "start_index": s, "beyond_s": inputs["beyond_s"],
+                     **found.row(inputs["cap_N"]), "design": population.space.design(found.d)})
+        if found.reached:
+            break
+    nearest = rows[best_row(rows)]
+    return {"status": "done", "verified": False, "bird": inputs["bird"], "rows": rows,
+            "starts": len(inputs["starts"]), "hold_time_s": nearest["hold_time_s"],
+            "max_finger_force_N": nearest["max_finger_force_N"]}
 
 
 def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, case: Case,
-              screens: dict, progress: Progress | None) -> Outcome:
-    """The tightest cap's loop after the feasibility screen: from the first
-    start's design that reached the screen's goal, else not run (the best
+              screened: dict, progress: Progress | None) -> Outcome:
+    """The tightest cap's loop after the feasibility screen: from the design
+    of the start that reached the screen's goal, else not run (the best
     start's design, with the screen's evidence)."""
-    rows = list(screens.values())
+    rows = screened["rows"]
     reached = [r for r in rows if r["reached"]]
     if not reached:
         (progress or (lambda message: None))(

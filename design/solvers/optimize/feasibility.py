@@ -17,7 +17,8 @@ bird at all keeps it within its limits and holds nobody.
   distance from the goal (:func:`distance`): a design that lifts the bird
   and presses too hard is nearer than one that keeps its limits by never
   lifting it. Each start ends at the first design that reaches the goal, or
-  when its budget of simulations is spent.
+  when its budget of simulations is spent; the starts are tried in turn,
+  and the first that reaches the goal ends the screen.
 * Each simulation has a budget of contact work (:data:`NEWTON_SOLVES`):
   one past it stops and counts as a failed run.
 * A design that reaches it starts the population's search.
