@@ -384,7 +384,7 @@ def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
             break
     nearest = rows[best_row(rows)]
     return {"status": "done", "verified": False, "bird": inputs["bird"], "rows": rows,
-            "starts": len(inputs["starts"]), "hold_time_s": nearest["hold_time_s"],
+            "hold_time_s": nearest["hold_time_s"],
             "max_finger_force_N": nearest["max_finger_force_N"]}
 
 
