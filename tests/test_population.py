@@ -230,6 +230,20 @@ def _two_birds(caps_scale=(1.5, 1.5)):
     return two, base.peak * np.asarray(caps_scale)
 
 
+def test_a_populations_verification_names_its_birds_finger_model():
+    """The population's verification says which finger model its birds ran
+    (the closing line quotes it): a spatial scene's, not a default."""
+    from design.solvers.optimize.trust_region import population_verdict
+
+    two, caps = _two_birds()
+    spatial = editable(two)
+    for member in spatial.members:
+        member.run.summary["finger_model"] = "spatial"
+    claims = [(m.hold, "test") for m in spatial.members]
+    assert population_verdict(spatial.population, claims, spatial, caps)["finger_model"] == \
+        "spatial"
+
+
 def test_the_screen_takes_the_bird_furthest_from_its_limits():
     """No screen where every bird keeps its limits; else the bird whose
     finger presses furthest over its cap, the first of equals, and a jammed

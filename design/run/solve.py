@@ -603,9 +603,9 @@ def status_line(result: dict) -> str:
     claimed = result["objective"]["hold_time_s"]
     claimed = "not evaluated" if claimed is None or not np.isfinite(claimed) else \
         f"{claimed:.4f} s"
-    model = v.get("finger_model", "planar")
     return (f"{status}{caveat}: hold {v['hold_time_s']:.4f} s in the independent simulation "
-            f"with {model} fingers (optimiser {claimed}; baseline {b['hold_time_s']:.4f} s), "
+            f"with {v['finger_model']} fingers (optimiser {claimed}; baseline "
+            f"{b['hold_time_s']:.4f} s), "
             f"{peak}{check}")
 
 

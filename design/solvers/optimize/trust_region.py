@@ -595,7 +595,8 @@ def population_verdict(population: Population, claims: list, verified: Scored, c
                                         verified.members, caps)]
     k = int(np.argmax(verified.peaks / np.asarray(caps)))
     tight, limiting = birds[k], birds[verified.limiting]
-    return {"aggregate": population.aggregate, "hold_time_s": verified.hold,
+    return {"aggregate": population.aggregate, "finger_model": limiting["finger_model"],
+            "hold_time_s": verified.hold,
             "hold_windows": limiting["hold_windows"], "limiting_bird": limiting["bird"],
             "max_finger_force_N": tight["max_finger_force_N"],
             "max_finger_force_finger": tight["max_finger_force_finger"],
