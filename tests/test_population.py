@@ -381,10 +381,10 @@ def test_the_screened_cap_searches_from_the_first_start_that_reached_the_limits(
                         calls.append(("unreached", [r["d"] for r in rows], bird)) or "nearest")
     row = {"bird": "large-bird-2.30kg", "reached": False, "d": [0.1]}
     rows = [row, {**row, "reached": True, "d": [0.7]}]
-    assert solve._screened(problem, None, np.ones(2), None, {"rows": rows}, None) == "searched"
+    assert solve._screened(problem, None, np.ones(2), {"rows": rows}, None) == "searched"
     assert calls[-1][0] == "search" and calls[-1][1].tolist() == [0.7] and calls[-1][2]
     missed = [row, {**row, "d": [0.7]}, {**row, "d": [0.9]}]
-    assert solve._screened(problem, None, np.ones(2), None, {"rows": missed}, None) == "nearest"
+    assert solve._screened(problem, None, np.ones(2), {"rows": missed}, None) == "nearest"
     assert calls[-1] == ("unreached", [[0.1], [0.7], [0.9]], "large-bird-2.30kg")
 
 

@@ -324,7 +324,7 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     say(f"cap {k + 1} of {len(problem.caps)}: {caps_text(caps)} "
         f"({problem.caps[k].describe()})")
     if case.inputs.get("screened"):
-        outcome = _screened(problem, population, caps, case, upstream, progress)
+        outcome = _screened(problem, population, caps, upstream, progress)
     else:
         start = np.array(upstream["d"]) if upstream else np.array(case.inputs["start"])
         first = upstream is None and case.inputs["start_index"] == 0
@@ -388,7 +388,7 @@ def _screen(problem: DesignProblem, population: Population, case: Case) -> dict:
             "max_finger_force_N": nearest["max_finger_force_N"]}
 
 
-def _screened(problem: DesignProblem, population: Population, caps: np.ndarray, case: Case,
+def _screened(problem: DesignProblem, population: Population, caps: np.ndarray,
               screened: dict, progress: Progress | None) -> Outcome:
     """The tightest cap's loop after the feasibility screen: from the design
     of the start that reached the screen's goal, else not run (the best
