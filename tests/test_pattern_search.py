@@ -4,12 +4,15 @@ keeps its budget and the allowed region, and its path does not move when
 the objective and the start move by round-off."""
 
 import os
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from design.solvers.optimize import pattern_search
+from design.solvers.optimize import pattern_search, trust_region
 from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
+from design.solvers.optimize.population import Member, Population
+from design.solvers.optimize.trust_region import Evaluated
 
 CENTRE = np.array([0.71, 0.23, 0.5, 0.9])
 WEIGHT = np.array([1.0, 3.0, 0.5, 2.0])
@@ -24,7 +27,7 @@ def quadratic(d, noise: float = 0.0):
 
 
 def run(d0, noise=0.0, band=1e-6, **kw):
-    def evaluate_many(designs):
+    def evaluate_many(designs, incumbent):
         return [quadratic(d, noise) for d in designs]
     return compass(evaluate_many, np.asarray(d0, float), quadratic(d0, noise),
                    lambda a, b: a > b + band, **kw)
@@ -100,25 +103,90 @@ def test_steps_halve_from_an_eighth_to_one_lattice_unit_and_stop_at_the_box():
     assert np.all((found.d >= 0) & (found.d <= 1))
 
 
-class _Value:
-    """A stand-in for a scored design: its value and the process that made it."""
+#: a stand-in finger, fold force, birds' centres and hold weights for
+#: :func:`_bird_run`: bird b's hold is ``HOLD - sum(w (d - centre_b)^2)``,
+#: its one finger's force ``FORCE * (1 + d[0] - d[1] / 2) * (1 + b / 4)``
+_SETUP = SimpleNamespace(grasper=SimpleNamespace(fingers=[SimpleNamespace(name="1a")]))
+CENTRES = np.array([[0.6, 0.3, 0.5, 0.8], [0.7, 0.25, 0.4, 0.9], [0.75, 0.2, 0.55, 0.95]])
+HOLD, FORCE = 1.0, 10.0
 
-    members: list = []
 
-    def __init__(self, d):
-        self.value, self.pid = quadratic(d), os.getpid()
+def _bird_run(space, d, settings, integrator):
+    """A stand-in for one bird's simulation (``space`` is the bird's index):
+    its hold (s), its one finger's force (N) and the process that ran it."""
+    b, d = space, np.asarray(d, float)
+    hold = HOLD - float(np.sum(WEIGHT * (d - CENTRES[b]) ** 2))
+    force = FORCE * (1 + d[0] - d[1] / 2) * (1 + b / 4)
+    return Evaluated(d, SimpleNamespace(
+        setup=_SETUP, trajectory=None, windows=None,
+        summary={"ok": True, "jam": [], "hold_time_s": hold, "max_finger_force_N": force,
+                 "max_force_per_finger_N": {"1a": force}, "pid": os.getpid()}))
 
 
-def test_pairs_on_two_processes_give_what_one_gives(monkeypatch):
-    """The designs a search evaluates together go to two forked processes, in
-    order, with the values one process computes."""
-    monkeypatch.setattr(pattern_search, "score", lambda population, d, s, i: _Value(d))
+@pytest.fixture
+def birds(monkeypatch):
+    """Three stand-in birds (:func:`_bird_run`) whose fingers fold far above any cap."""
+    monkeypatch.setattr(pattern_search, "simulate", _bird_run)
+    monkeypatch.setattr(trust_region, "finger_limits", lambda setup, cap: np.array([cap]))
+    return Population(tuple(Member(f"bird-{b}", b) for b in range(3)))
+
+
+def test_pairs_on_two_processes_give_what_one_gives(birds):
+    """The birds of the designs a search evaluates together go to two forked
+    processes, in order, with the values one process computes."""
     designs = [np.full(4, x) for x in (0.1, 0.4, 0.7, 0.9)]
-    with Pairs(None, None, None, workers=1) as one, Pairs(None, None, None, workers=2) as two:
+    with Pairs(birds, None, None, workers=1) as one, Pairs(birds, None, None, workers=2) as two:
         here, there = one.score(designs), two.score(designs)
-    assert [v.value for v in here] == [v.value for v in there]
-    assert {v.pid for v in here} == {os.getpid()}
-    assert two.processes == 2 and os.getpid() not in {v.pid for v in there}
+    assert [v.holds.tolist() for v in here] == [v.holds.tolist() for v in there]
+    assert {m.run.summary["pid"] for v in here for m in v.members} == {os.getpid()}
+    pids = {m.run.summary["pid"] for v in there for m in v.members}
+    assert two.processes == 2 and os.getpid() not in pids
+    assert one.simulations == two.simulations == 12
+
+
+def test_a_population_search_that_rules_candidates_out_by_one_bird_takes_the_same_steps(birds):
+    """The worst hold of three birds under a cap that binds: the search with
+    every bird of every candidate simulated, and the search that stops
+    simulating a candidate at the first bird that shows it cannot beat the
+    incumbent, take the same steps to the same design, the second on fewer
+    simulations, on one process or two; every ruled-out candidate's bird
+    indeed cannot beat the incumbent it was judged against."""
+    caps = np.full(3, 13.0)
+    settings = SimpleNamespace(objective="hold", min_hold=None)
+    beats, cannot_beat = pattern_search.judges(birds, caps, settings)
+    d0 = np.full(4, 0.5)
+
+    def searched(test, workers):
+        with Pairs(birds, None, None, workers, test) as pool:
+            start, = pool.score([d0])
+            found = compass(pool.score, d0, start, beats, max_evaluations=40)
+        return found, pool.simulations, start
+
+    (every, n_every, start), (lazy, n_lazy, _), (lazy2, _, _) = (
+        searched(None, 1), searched(cannot_beat, 1), searched(cannot_beat, 2))
+    moves = [[(t.variable, t.units, t.move, t.taken) for t in f.trials] for f in
+             (every, lazy, lazy2)]
+    assert moves[0] == moves[1] == moves[2]
+    assert np.array_equal(every.d, lazy.d) and every.value.hold == lazy.value.hold
+    assert every.value.within(caps) and every.value.hold > start.hold + 0.01
+    ruled = [t for t in lazy.trials if t.value.ruled_out_by]
+    assert ruled and n_lazy < n_every - len(ruled)
+    complete = {tuple(t.d): t.value for t in every.trials}
+    assert not any(beats(complete[tuple(t.d)], incumbent)
+                   for t, incumbent in judged_against(lazy, start))
+
+
+def judged_against(found, start):
+    """Each ruled-out trial with an incumbent that it cannot beat: the last
+    step taken before it (the start where none), which is the one it was
+    judged against or a better one."""
+    incumbent, out = start, []
+    for t in found.trials:
+        if t.value.ruled_out_by:
+            out.append((t, incumbent))
+        if t.taken:
+            incumbent = t.value
+    return out
 
 
 def test_a_baseline_whose_simulation_ended_early_is_refused_naming_the_bird():

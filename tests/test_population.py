@@ -309,7 +309,7 @@ def test_the_screen_searches_for_a_lifted_bird_within_its_limits(monkeypatch):
         def __exit__(self, *exc):
             return False
 
-        def score(self, designs):
+        def score(self, designs, incumbent=None):
             return [Design(0.0, -5.0) for _ in designs]
 
     seen = {}

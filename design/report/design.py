@@ -146,16 +146,22 @@ def search_table(page: Page, solver: dict) -> None:
     if answered(s):
         screen_table(page, s)
         return
+    birds = any("ruled_out_by" in h for h in solver["history"])
     page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
               f"with every finger under the cap; {s['simulations']} simulations of at most "
               f"{s['max_simulations']}" + ("" if s["lattice_optimum"] else
-                                           ", the budget ending the search") + ".")
+                                           ", the budget ending the search") + "."
+              + (f" {s['bird_simulations']} bird simulations: a design's birds are "
+                 "simulated until one shows it cannot beat the design the search stands "
+                 "at (its hold and peak are then those of the birds simulated)."
+                 if birds else ""))
     page.table([{"simulation": h["iteration"], "step (scaled)": h["radius"],
                  "variable": h["variable"], "move": h["move"],
                  "simulated hold (s)": h["simulated_hold_time_s"],
                  "simulated peak (N)": h["simulated_peak_force_N"],
+                 **({"ruled out by": h.get("ruled_out_by") or ""} if birds else {}),
                  "taken": h["accepted"]} for h in solver["history"]],
                "Pattern search", "history-table")
 

@@ -39,7 +39,7 @@ from design.solvers.optimize.pattern_search import HOLD_BAND, Pairs, allowed_by,
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.transcription import Rules
 from design.solvers.optimize.trust_region import (FORCE_BAND, LoopSettings, Outcome, Scored,
-                                                   score)
+                                                   alone, score)
 
 #: each screen simulation's budget of belt-continuation rootfinder calls per
 #: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
@@ -60,11 +60,6 @@ METHOD = "feasibility screen"
 STARTS, SIMULATIONS = 4, 16
 
 
-def alone(scored: Scored, b: int) -> Scored:
-    """Bird ``b``'s part of a design scored for a population."""
-    return Scored(scored.d, [scored.members[b]], Population((scored.population.members[b],)))
-
-
 def hardest_bird(baseline: Scored, caps, tolerance: float) -> int | None:
     """The bird furthest from its limits (cap in N, fold forces, no jam) at
     ``baseline`` in :meth:`Scored.shortfall`'s order, the first of equals;
@@ -72,8 +67,8 @@ def hardest_bird(baseline: Scored, caps, tolerance: float) -> int | None:
     caps = np.broadcast_to(np.asarray(caps, float), (len(baseline.members),))
     if baseline.within(caps, tolerance):
         return None
-    shortfalls = [alone(baseline, b).shortfall(caps[b], tolerance)
-                  for b in range(len(baseline.members))]
+    shortfalls = [alone(run, member).shortfall(cap, tolerance) for run, member, cap
+                  in zip(baseline.members, baseline.population.members, caps)]
     return max(range(len(shortfalls)), key=lambda b: (shortfalls[b], -b))
 
 

@@ -25,9 +25,19 @@ comparison of two simulated holds or of a peak with the cap flips:
   the optimiser's grid): the cap is decided on the peak force, and a looser
   tolerance can step over a force transient of a few ms at a contact;
 * a budget of simulations ends the search, as deterministically;
-* the two designs of a poll or an extension are simulated in two
-  processes where there are two cores: the same simulations as one process
-  would run, in half the wall time.
+* a design of a population is judged bird by bird: once the incumbent
+  keeps every limit (aggregate ``worst``), a candidate beats it only if
+  every bird stays within its limits and holds longer than the incumbent's
+  worst hold by more than the band, so one bird that does not rules the
+  candidate out. The birds are simulated in the order of the incumbent's
+  holds, shortest first, two at a time, until one rules the candidate out;
+  the birds after it are not simulated. The search takes the same steps as
+  with every bird simulated (a candidate ruled out against one incumbent is
+  ruled out against any later, better one), on fewer simulations;
+* the simulations of a poll or an extension (two designs' birds, or one
+  design's) are handed out one bird at a time to two processes where there
+  are two cores: the same simulations as one process would run, in about
+  half the wall time.
 
 The search's claim for its design is its own simulation of it; the
 verification simulates it again at 4x finer resolution (steps a quarter of
@@ -43,7 +53,7 @@ import copy
 import multiprocessing
 import resource
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -52,9 +62,9 @@ from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
 from design.solvers.optimize.transcription import Rules, rule_margins
-from design.solvers.optimize.trust_region import (LoopSettings, Outcome, Scored, better,
-                                                   caps_text, caps_value, check_baseline,
-                                                   population_of, score)
+from design.solvers.optimize.trust_region import (Evaluated, LoopSettings, Outcome, Scored,
+                                                   alone, better, caps_text, caps_value,
+                                                   check_baseline, population_of, simulate)
 from design.solvers.optimize.variables import DesignSpace
 
 #: the lattice's unit and the first step, in lattice units (scaled variables)
@@ -95,8 +105,10 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     """The coordinate search of the module's docstring on the lattice
     ``clip(d0 + LATTICE * k, 0, 1)`` (scaled variables, integer ``k``).
 
-    ``evaluate_many(designs)`` gives the values of a list of designs (the
-    caller may evaluate them in parallel), ``value0`` is ``d0``'s;
+    ``evaluate_many(designs, incumbent)`` gives the values of a list of
+    designs (the caller may evaluate them in parallel; a value that cannot
+    beat the ``incumbent``'s may be marked ``ruled_out_by`` and left
+    partial), ``value0`` is ``d0``'s;
     ``beats(a, b)`` says whether value a is better than b; a design that is
     not ``allowed`` is not tried; ``moved(trial, count)`` hears of every
     step taken; the search ends at the first point (``d0`` or a step taken)
@@ -119,14 +131,14 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     def evaluate(tried: list[tuple], i: int, move: str) -> list:
         """The values of ``tried``'s points ((k, units) pairs), the unseen ones
         evaluated together, as many as the budget allows (None beyond it)."""
-        new = [k for k in dict.fromkeys(k for k, _ in tried) if k not in seen]
+        new = [p for p in dict.fromkeys(p for p, _ in tried) if p not in seen]
         new = new[:max(0, max_evaluations - len(seen))]
         if new:
-            for k, v in zip(new, evaluate_many([point(k) for k in new])):
-                seen[k] = v
-                trial_at[k] = Trial(point(k), v, i, dict(tried)[k], move)
-                trials.append(trial_at[k])
-        return [seen.get(k) for k, _ in tried]
+            for p, v in zip(new, evaluate_many([point(p) for p in new], seen[k])):
+                seen[p] = v
+                trial_at[p] = Trial(point(p), v, i, dict(tried)[p], move)
+                trials.append(trial_at[p])
+        return [seen.get(p) for p, _ in tried]
 
     class Enough(Exception):
         """A step reached a point whose value is enough."""
@@ -210,16 +222,12 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     say = progress or (lambda message: None)
     population = population_of(space)
     caps = np.broadcast_to(np.asarray(cap, float), (len(population.members),)).copy()
-    pool = Pairs(population, settings, settings.simulator, workers)
+    beats, cannot_beat = judges(population, caps, settings)
+    pool = Pairs(population, settings, settings.simulator, workers, cannot_beat)
 
-    def simulate_all(designs):
+    def simulate_all(designs, incumbent=None):
         with profile.phase(SIMULATIONS):
-            return pool.score(designs)
-
-    def beats(a: Scored, b: Scored) -> bool:
-        if settings.objective == "throughput":
-            return faster(a, b, caps, settings.min_hold, HOLD_BAND)
-        return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
+            return pool.score(designs, incumbent)
 
     d0 = population.space.scale(population.space.base_values)
     allowed = allowed_by(population.space, rules)
@@ -254,8 +262,10 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         "variable": names[t.variable], "direction": int(np.sign(t.units)),
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
-        **({} if len(caps) == 1 else {"simulated_hold_times_s": t.value.holds.tolist(),
-                                      "simulated_peak_forces_N": t.value.peaks.tolist()}),
+        **({} if len(caps) == 1 else {
+            "simulated_hold_times_s": per_bird(population, t.value, "hold"),
+            "simulated_peak_forces_N": per_bird(population, t.value, "peak"),
+            "ruled_out_by": t.value.ruled_out_by}),
         **({} if settings.objective != "throughput" else {
             "line_rate_per_min": rate_of(t.value), "keeps_limits": t.value.within(caps),
             "jammed_birds": t.value.shortfall(caps)[1]})}
@@ -263,6 +273,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
                   "simulations": len(found.trials) + 1 + (start is not None),
+                  "bird_simulations": pool.simulations,
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes,
                   "processes_cpu_time_s": pool.children_cpu_time,
@@ -272,38 +283,85 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     return out
 
 
+def judges(population: Population, caps: np.ndarray, settings: LoopSettings):
+    """How the search compares designs: ``beats(a, b)``, in which a
+    ruled-out candidate beats nothing and anything else beats it; and, where
+    the population's worst hold counts, ``cannot_beat(incumbent)``: None
+    where the incumbent breaks a limit (then a candidate's every bird
+    counts), else the test of one bird's simulation ``(bird index,
+    Evaluated)`` that rules a candidate out: the bird breaks its limits, or
+    holds no longer than the incumbent's worst hold and the band."""
+    def beats(a: Scored, b: Scored) -> bool:
+        if a.ruled_out_by or b.ruled_out_by:
+            return not a.ruled_out_by
+        if settings.objective == "throughput":
+            return faster(a, b, caps, settings.min_hold, HOLD_BAND)
+        return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
+
+    def cannot_beat(incumbent: Scored):
+        if not incumbent.within(caps):
+            return None
+        return lambda b, run: not alone(run, population.members[b]).within(caps[b]) \
+            or run.hold <= incumbent.hold + HOLD_BAND
+    lazy = settings.objective != "throughput" and population.aggregate == "worst" \
+        and len(population.members) > 1
+    return beats, cannot_beat if lazy else None
+
+
+def per_bird(population: Population, value: Scored, what: str) -> list:
+    """Each bird's hold (s) or peak (N), ``what``, in the population's order;
+    None for a bird a ruled-out candidate did not simulate."""
+    simulated = {id(m): getattr(e, what) for m, e in zip(value.population.members,
+                                                          value.members)}
+    return [simulated.get(id(m)) for m in population.members]
+
+
+#: a population's birds simulated at once for one candidate when it may be
+#: ruled out (the most processes a pool has): the same on any machine, so
+#: that a ruled-out candidate's record does not depend on the core count
+BIRDS_AT_ONCE = 2
+
 #: the population, loop settings and integrator of a :class:`Pairs` pool's
 #: forked processes (set before they fork; the parent's only otherwise)
 _SCORING: tuple | None = None
 
 
-def _score_slim(d: np.ndarray) -> Scored:
+def _simulate_slim(job: tuple[np.ndarray, int]) -> Evaluated:
     population, settings, integrator = _SCORING
-    return slim(score(population, d, settings, integrator))
+    d, b = job
+    return slim(simulate(population.members[b].space, d, settings, integrator))
 
 
-def slim(scored: Scored) -> Scored:
-    """The scored design without its trajectories (tens of MB each): what a
-    search decides by (each run's setup and summary) passes between processes."""
-    for member in scored.members:
-        summary = member.run.summary
-        member.run = copy.copy(member.run)
-        member.run.trajectory, member.run.windows = None, None
-        member.run.__dict__["summary"] = summary
-    return scored
+def slim(run: Evaluated) -> Evaluated:
+    """A bird's simulation without its trajectories (tens of MB each): what a
+    search decides by (the run's setup and summary) passes between processes."""
+    summary = run.run.summary
+    run.run = copy.copy(run.run)
+    run.run.trajectory, run.run.windows = None, None
+    run.run.__dict__["summary"] = summary
+    return run
 
 
 class Pairs:
     """Simulates the designs a search evaluates together (a poll's two, an
-    extension's two) in forked processes, or here where there is one core,
-    no ``fork``, or this process is a daemon (a Dask worker's) that may not
-    have children. A forked child computes exactly what this process would."""
+    extension's two) for every bird, one bird of one design at a time, in
+    forked processes, or here where there is one core, no ``fork``, or this
+    process is a daemon (a Dask worker's) that may not have children. A
+    forked child computes exactly what this process would.
+
+    With ``cannot_beat`` (an incumbent -> a test ``(bird index, Evaluated)
+    -> bool``, or None where the incumbent admits no such test) a
+    candidate's birds are simulated, :data:`BIRDS_AT_ONCE` at a time, the
+    incumbent's shortest hold first, until one rules it out."""
 
     def __init__(self, population: Population, settings: LoopSettings, integrator,
-                 workers: int | None):
+                 workers: int | None, cannot_beat=None):
         self.job = (population, settings, integrator)
         self.processes = processes(workers)
+        self.cannot_beat = cannot_beat
         self.pool = None
+        #: the birds simulated (one design, one bird each)
+        self.simulations = 0
         #: the CPU time (s) of the forked processes, once they have ended
         #: (this process's own is in the run's profile)
         self.children_cpu_time = 0.0
@@ -324,11 +382,40 @@ class Pairs:
             self.pool, _SCORING = None, None
             self.children_cpu_time = _children_cpu() - self._children_before
 
-    def score(self, designs: list) -> list[Scored]:
-        if self.pool is None or len(designs) == 1:
+    def _simulate(self, jobs: list[tuple[np.ndarray, int]]) -> list[Evaluated]:
+        self.simulations += len(jobs)
+        if self.pool is None or len(jobs) == 1:
             population, settings, integrator = self.job
-            return [slim(score(population, d, settings, integrator)) for d in designs]
-        return self.pool.map(_score_slim, designs, chunksize=1)
+            return [slim(simulate(population.members[b].space, d, settings, integrator))
+                    for d, b in jobs]
+        return self.pool.map(_simulate_slim, jobs, chunksize=1)
+
+    def score(self, designs: list, incumbent: Scored | None = None) -> list[Scored]:
+        """Each design scored for the population; candidates that cannot beat
+        the ``incumbent`` partly, ``ruled_out_by`` the bird that shows it."""
+        population = self.job[0]
+        birds = range(len(population.members))
+        test = self.cannot_beat(incumbent) if self.cannot_beat and incumbent else None
+        order = sorted(birds, key=lambda b: (incumbent.holds[b], b)) if test else list(birds)
+        runs: list[dict] = [{} for _ in designs]
+        out: list[Scored | None] = [None] * len(designs)
+        while pending := [i for i, o in enumerate(out) if o is None]:
+            width = max(1, BIRDS_AT_ONCE // len(pending)) if test else len(order)
+            jobs = [(i, b) for i in pending
+                    for b in [b for b in order if b not in runs[i]][:width]]
+            for (i, b), run in zip(jobs, self._simulate([(designs[i], b) for i, b in jobs])):
+                runs[i][b] = run
+            for i in pending:
+                ruled = [b for b in order if b in runs[i] and test and test(b, runs[i][b])]
+                if ruled or len(runs[i]) == len(order):
+                    simulated = [b for b in birds if b in runs[i]]
+                    out[i] = Scored(np.asarray(designs[i], float),
+                                    [runs[i][b] for b in simulated],
+                                    population if len(simulated) == len(order) else
+                                    replace(population, members=tuple(
+                                        population.members[b] for b in simulated)),
+                                    population.members[ruled[0]].name if ruled else None)
+        return out
 
 
 def _children_cpu() -> float:

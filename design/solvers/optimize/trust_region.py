@@ -47,7 +47,7 @@ from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import GraspRun, simulate_grasp
 from design.solvers.grasp.validity import finger_limits, validity_problems
 from design.solvers.optimize.forked import forked_map
-from design.solvers.optimize.population import Population, PopulationNLP
+from design.solvers.optimize.population import Member, Population, PopulationNLP
 from design.solvers.optimize.profile import CONSTRUCTION, OPTIMISER, SIMULATIONS, VIEWS, Profile
 from design.solvers.optimize.schedule import schedule_of
 from design.solvers.optimize.transcription import DesignNLP, NLPResult, NLPSettings, Rules
@@ -123,6 +123,10 @@ class Scored:
     d: np.ndarray
     members: list[Evaluated]
     population: Population
+    #: a search's candidate whose birds were simulated only until one of
+    #: them showed that it cannot beat the search's incumbent: that bird's
+    #: name (``members`` and ``population`` are then the birds simulated)
+    ruled_out_by: str | None = None
 
     @property
     def holds(self) -> np.ndarray:
@@ -185,6 +189,11 @@ class Scored:
         """Does every bird stay under its cap (N) and every finger under its
         fold force, within ``tolerance`` (relative), with no bird jammed?"""
         return self.excess(caps, tolerance) <= 0.0
+
+
+def alone(run: Evaluated, member: Member) -> Scored:
+    """One bird's simulation as a design scored for that bird alone."""
+    return Scored(run.d, [run], Population((member,)))
 
 
 def unmeasured_jams(summary: dict) -> list[str]:
