@@ -16,14 +16,15 @@ Each prints a table and writes its entry of benchmarks/results/flock.json
 workers the study's entry, on any other number its own
 (``line_on_1_workers``), so that the page compares the wall times.
 
-    python -m benchmarks.flock population [--workers 2]
-    python -m benchmarks.flock line [--workers 2]
+    python -m benchmarks.flock population [--workers 2] [--out DIR]
+    python -m benchmarks.flock line [--workers 2] [--out DIR]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+from collections import Counter
 import os
 import tempfile
 import time
@@ -59,10 +60,14 @@ def population_entry(result: dict) -> dict:
         for r in screen["starts"]:
             print(f"{r['start_index']:5d} {r['simulations']:5d} {str(r['within']):>6s} "
                   f"{r['jammed']:3d} {r['hold_time_s']:8.4f} {r['max_finger_force_N']:8.2f}")
+    ruled = Counter(h.get("ruled_out_by") for h in result["solver"]["history"])
+    ruled.pop(None, None)
     return {"cap_N": result["cap"]["N"], "birds": p["birds"],
             "hold_time_s": p["hold_time_s"], "limiting_bird": p["limiting_bird"],
             "single_bird_design": p["single_bird_design"], "robust_design": result["design"],
-            "simulations": search["simulations"], "screen": screen,
+            "simulations": search["simulations"],
+            "bird_simulations": search.get("bird_simulations"),
+            "candidates_ruled_out_by": dict(ruled), "screen": screen,
             "profile": result["profile"]}
 
 
@@ -87,12 +92,14 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("study", choices=sorted(PROBLEMS))
     parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--out", type=Path, help="keep the run's files (result.json, report) "
+                        "here; by default they go to a temporary folder")
     args = parser.parse_args()
     problem = PROBLEMS[args.study]
     load = os.getloadavg()
     t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory() as out:
-        result = solve(problem, out=out, workers=args.workers,
+    with tempfile.TemporaryDirectory() as scratch:
+        result = solve(problem, out=args.out or scratch, workers=args.workers,
                        progress=lambda message: print(f"  {message}", flush=True)).to_dict()
     wall = time.perf_counter() - t0
     entry = (population_entry if args.study == "population" else line_entry)(result)
