@@ -68,9 +68,9 @@ class ModelCheck:
     ``submit(label, population, d)`` queues every bird's run of the scaled
     design d, ``submit_setups(label, setups)`` any scenes' (the robustness
     table's, design/solvers/optimize/robustness.py); ``result(...)`` waits
-    for a baseline's and an optimum's runs and compares them. ``close()`` (or the ``with`` block) stops the
-    process, also amid a run (Ctrl-C, a failed case): a simulation still
-    running there is not waited for."""
+    for a baseline's and an optimum's runs and compares them. ``close()``
+    (or the ``with`` block) stops the process, also amid a run (Ctrl-C, a
+    failed case): a simulation still running there is not waited for."""
 
     #: how often a wait looks for a result (s)
     POLL = 0.02

@@ -191,8 +191,9 @@ class DesignNLP:
     def _runge_kutta(self, grid, values) -> dict:
         """The RK4 stages of every interval: (j, k) -> (the summed finger
         loads at each stage, the stage derivatives k_s, the finger forces in
-        stage then finger order, each with its finger's index). Built stage by stage across all intervals
-        (stage s needs stage s-1 of its own interval only), so that each
+        stage then finger order, each with its finger's index). Built stage
+        by stage across all intervals (stage s needs stage s-1 of its own
+        interval only), so that each
         finger and contact mode is one batched call per stage
         (FingerLoad.batch) instead of a call per interval."""
         sch, grasper = self.schedule, self.setup.grasper
