@@ -29,9 +29,10 @@ comparison of two simulated holds or of a peak with the cap flips:
   keeps every limit (aggregate ``worst``), a candidate beats it only if
   every bird stays within its limits and holds longer than the incumbent's
   worst hold by more than the band, so one bird that does not rules the
-  candidate out. The birds are simulated in the order of the incumbent's
-  holds, shortest first, two at a time, until one rules the candidate out;
-  the birds after it are not simulated. The search takes the same steps as
+  candidate out. The incumbent's shortest-held bird is simulated first,
+  alone (it rules most candidates out: the one that limits the incumbent
+  limits its neighbours), and only if it does not, the other birds
+  together. The search takes the same steps as
   with every bird simulated (a candidate ruled out against one incumbent is
   ruled out against any later, better one), on fewer simulations;
 * the simulations of a poll or an extension (two designs' birds, or one
@@ -316,11 +317,6 @@ def per_bird(population: Population, value: Scored, what: str) -> list:
     return [simulated.get(id(m)) for m in population.members]
 
 
-#: a population's birds simulated at once for one candidate when it may be
-#: ruled out (the most processes a pool has): the same on any machine, so
-#: that a ruled-out candidate's record does not depend on the core count
-BIRDS_AT_ONCE = 2
-
 #: the population, loop settings and integrator of a :class:`Pairs` pool's
 #: forked processes (set before they fork; the parent's only otherwise)
 _SCORING: tuple | None = None
@@ -351,8 +347,9 @@ class Pairs:
 
     With ``cannot_beat`` (an incumbent -> a test ``(bird index, Evaluated)
     -> bool``, or None where the incumbent admits no such test) a
-    candidate's birds are simulated, :data:`BIRDS_AT_ONCE` at a time, the
-    incumbent's shortest hold first, until one rules it out."""
+    candidate's first bird is the incumbent's shortest-held, alone; its
+    other birds are simulated only if that one does not rule it out (the
+    same birds on any number of processes)."""
 
     def __init__(self, population: Population, settings: LoopSettings, integrator,
                  workers: int | None, cannot_beat=None):
@@ -400,9 +397,9 @@ class Pairs:
         runs: list[dict] = [{} for _ in designs]
         out: list[Scored | None] = [None] * len(designs)
         while pending := [i for i, o in enumerate(out) if o is None]:
-            width = max(1, BIRDS_AT_ONCE // len(pending)) if test else len(order)
-            jobs = [(i, b) for i in pending
-                    for b in [b for b in order if b not in runs[i]][:width]]
+            # a candidate that may be ruled out: its first bird alone, then the rest
+            jobs = [(i, b) for i in pending for b in
+                    [b for b in order if b not in runs[i]][:1 if test and not runs[i] else None]]
             for (i, b), run in zip(jobs, self._simulate([(designs[i], b) for i, b in jobs])):
                 runs[i][b] = run
             for i in pending:
