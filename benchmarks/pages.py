@@ -348,8 +348,15 @@ def population(path: Path, data: dict) -> list[str]:
         columns.update({f"{words}: hold (s)": lambda r, k=key: r[f"{k}_hold_time_s"],
                         f"{words}: peak (N)": lambda r, k=key: r[f"{k}_max_finger_force_N"],
                         f"{words}: jam": lambda r, k=key: r[f"{k}_jam"]})
-    simulated = f"{p['simulations']} simulations of the feasibility screen" if screen else \
-        f"{p['simulations']} designs simulated for every bird"
+    if screen:
+        simulated = f"{p['simulations']} simulations of the feasibility screen"
+    elif p.get("bird_simulations") is None:
+        simulated = f"{p['simulations']} designs simulated for every bird"
+    else:
+        ruled = ", ".join(f"{n} by {bird}" for bird, n in p["candidates_ruled_out_by"].items())
+        simulated = (f"the population's search: {p['simulations']} designs in "
+                     f"{p['bird_simulations']} bird simulations, candidates ruled out "
+                     f"{ruled or 'by none'}")
     lines = [f"`{p['command']}`: {p['status']} in {p['wall_time_s']:.0f} s on {p['workers']} "
              f"workers ({simulated}), caps {caps(p['cap_N'])}: {p['message']}", ""]
     if screen:
