@@ -32,13 +32,13 @@ comparison of two simulated holds or of a peak with the cap flips:
   candidate out. The incumbent's shortest-held bird is simulated first,
   alone (it rules most candidates out: the one that limits the incumbent
   limits its neighbours), and only if it does not, the other birds
-  together. The search takes the same steps as
-  with every bird simulated (a candidate ruled out against one incumbent is
-  ruled out against any later, better one), on fewer simulations;
+  together. The search takes the same steps as with every bird simulated
+  (a candidate ruled out against one incumbent is ruled out against any
+  later, better one), on fewer simulations;
 * the simulations of a poll or an extension (two designs' birds, or one
   design's) are handed out one bird at a time to two processes where there
-  are two cores: the same simulations as one process would run, in about
-  half the wall time.
+  are two cores: the same simulations as one process would run, two at
+  once.
 
 The search's claim for its design is its own simulation of it; the
 verification simulates it again at 4x finer resolution (steps a quarter of
