@@ -150,9 +150,9 @@ def search_table(page: Page, solver: dict) -> None:
     page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
-              f"with every finger under the cap; {s['simulations']} simulations of at most "
-              f"{s['max_simulations']}" + ("" if s["lattice_optimum"] else
-                                           ", the budget ending the search") + "."
+              f"with every finger under the cap; {s['simulations']} designs simulated, the "
+              f"baseline's included, on a budget of {s['max_simulations']} from the start"
+              + ("" if s["lattice_optimum"] else ", the budget ending the search") + "."
               + (f" {s['bird_simulations']} bird simulations: a design's birds are "
                  "simulated until one shows it cannot beat the design the search stands "
                  "at (its hold and peak are then those of the birds simulated)."
