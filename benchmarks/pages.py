@@ -370,7 +370,8 @@ def population(path: Path, data: dict) -> list[str]:
                       "hold (s)": lambda r: r["hold_time_s"],
                       "peak (N)": lambda r: r["max_finger_force_N"],
                       "finger": lambda r: r["max_finger_force_finger"]}), ""]
-    lines += ["Each bird at 4x finer resolution:", "", *table(p["birds"], columns)]
+    lines += ["Each bird at 4x finer resolution:", "", *table(p["birds"], columns),
+              *other_workers(data, "population", p)]
     return section("The flock: one design for Table 5-5's birds", "flock population", path, p,
                    lines)
 
