@@ -322,8 +322,10 @@ def per_bird(population: Population, value: Scored, what: str) -> list:
 _SCORING: tuple | None = None
 
 
-def _simulate_slim(job: tuple[np.ndarray, int]) -> Evaluated:
-    population, settings, integrator = _SCORING
+def _simulate_slim(job: tuple[np.ndarray, int], scoring: tuple | None = None) -> Evaluated:
+    """Bird ``b``'s simulation of the scaled design ``d`` (``job``), slim, by
+    ``scoring``'s population, settings and integrator (default: the pool's)."""
+    population, settings, integrator = scoring or _SCORING
     d, b = job
     return slim(simulate(population.members[b].space, d, settings, integrator))
 
@@ -382,9 +384,7 @@ class Pairs:
     def _simulate(self, jobs: list[tuple[np.ndarray, int]]) -> list[Evaluated]:
         self.simulations += len(jobs)
         if self.pool is None or len(jobs) == 1:
-            population, settings, integrator = self.job
-            return [slim(simulate(population.members[b].space, d, settings, integrator))
-                    for d, b in jobs]
+            return [_simulate_slim(job, self.job) for job in jobs]
         return self.pool.map(_simulate_slim, jobs, chunksize=1)
 
     def score(self, designs: list, incumbent: Scored | None = None) -> list[Scored]:
