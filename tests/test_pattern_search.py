@@ -133,11 +133,13 @@ def birds(monkeypatch):
 
 def test_pairs_on_two_processes_give_what_one_gives(birds):
     """The birds of the designs a search evaluates together go to two forked
-    processes, in order, with the values one process computes."""
+    processes, in order, with the values one process computes: each bird's
+    own simulation of its design."""
     designs = [np.full(4, x) for x in (0.1, 0.4, 0.7, 0.9)]
     with Pairs(birds, None, None, workers=1) as one, Pairs(birds, None, None, workers=2) as two:
         here, there = one.score(designs), two.score(designs)
-    assert [v.holds.tolist() for v in here] == [v.holds.tolist() for v in there]
+    assert [v.holds.tolist() for v in here] == [v.holds.tolist() for v in there] == [
+        [_bird_run(b, d, None, None).hold for b in range(3)] for d in designs]
     assert {m.run.summary["pid"] for v in here for m in v.members} == {os.getpid()}
     pids = {m.run.summary["pid"] for v in there for m in v.members}
     assert two.processes == 2 and os.getpid() not in pids
@@ -171,6 +173,12 @@ def test_a_population_search_that_rules_candidates_out_by_one_bird_takes_the_sam
     assert every.value.within(caps) and every.value.hold > start.hold + 0.01
     ruled = [t for t in lazy.trials if t.value.ruled_out_by]
     assert ruled and n_lazy < n_every - len(ruled)
+    # a ruled-out candidate carries the birds it simulated, each its own run
+    for t in ruled:
+        members = t.value.population.members
+        assert t.value.ruled_out_by in [m.name for m in members]
+        assert [e.hold for e in t.value.members] == [
+            _bird_run(m.space, t.d, None, None).hold for m in members]
     complete = {tuple(t.d): t.value for t in every.trials}
     assert not any(beats(complete[tuple(t.d)], incumbent)
                    for t, incumbent in judged_against(lazy, start))
