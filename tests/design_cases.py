@@ -110,14 +110,16 @@ def _inputs(setup, integrator, contact_nodes, reach_filter) -> str:
 
 
 def shared_simulate_grasp(setup, integrator: IntegratorSettings = IntegratorSettings(),
-                          contact_nodes: int = 6, reach_filter: bool = True, progress=None):
+                          contact_nodes: int = 6, reach_filter: bool = True, progress=None,
+                          watch=None):
     """:func:`~design.solvers.grasp.simulation.simulate_grasp`, run once per
     distinct input in the session; the run returned carries the caller's
     setup. Without a wall-time limit the simulation is deterministic, so a
     repeat would give the same run; its records are shared, so a test must
-    not change them."""
-    if integrator.max_wall_time is not None:        # the run depends on the machine
-        return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress)
+    not change them. A run that a watch may end is not shared."""
+    if integrator.max_wall_time is not None or watch is not None:   # not the inputs alone
+        return simulation.simulate_grasp(setup, integrator, contact_nodes, reach_filter, progress,
+                                         watch)
     key = _inputs(setup, integrator, contact_nodes, reach_filter)
     if key not in _RUNS:
         # computed ahead by the prefetch worker if it was given these inputs
@@ -163,7 +165,7 @@ def asked(call) -> tuple:
     is simulated. So the prefetched inputs are the tests' own, settings such
     as the verification's resolution included."""
     def stop(setup, integrator=IntegratorSettings(), contact_nodes=6, reach_filter=True,
-             progress=None):
+             progress=None, watch=None):
         raise _Asked(setup, integrator, contact_nodes, reach_filter)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr("design.solvers.optimize.trust_region.simulate_grasp", stop)

@@ -4,6 +4,7 @@ keeps its budget and the allowed region, and its path does not move when
 the objective and the start move by round-off."""
 
 import os
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -111,16 +112,25 @@ CENTRES = np.array([[0.6, 0.3, 0.5, 0.8], [0.7, 0.25, 0.4, 0.9], [0.75, 0.2, 0.5
 HOLD, FORCE = 1.0, 10.0
 
 
-def _bird_run(space, d, settings, integrator):
+def _bird_run(space, d, settings, integrator, cutoff=None):
     """A stand-in for one bird's simulation (``space`` is the bird's index):
-    its hold (s), its one finger's force (N) and the process that ran it."""
+    its hold (s), its one finger's force (N) and the process that ran it;
+    with a ``cutoff`` it cannot beat, a run stopped at its start (hold and
+    force 0) that says so and keeps the cutoff."""
     b, d = space, np.asarray(d, float)
-    hold = HOLD - float(np.sum(WEIGHT * (d - CENTRES[b]) ** 2))
-    force = FORCE * (1 + d[0] - d[1] / 2) * (1 + b / 4)
+    return _stand_in(d, HOLD - float(np.sum(WEIGHT * (d - CENTRES[b]) ** 2)),
+                     FORCE * (1 + d[0] - d[1] / 2) * (1 + b / 4), cutoff)
+
+
+def _stand_in(d, hold, force, cutoff):
+    stopped = cutoff is not None and (hold <= cutoff.hold or force > cutoff.cap)
+    if stopped:
+        hold, force = 0.0, 0.0
     return Evaluated(d, SimpleNamespace(
         setup=_SETUP, trajectory=None, windows=None,
         summary={"ok": True, "jam": [], "hold_time_s": hold, "max_finger_force_N": force,
-                 "max_force_per_finger_N": {"1a": force}, "pid": os.getpid()}))
+                 "max_force_per_finger_N": {"1a": force}, "pid": os.getpid(),
+                 "stopped": "cannot beat" if stopped else None, "cutoff": cutoff}))
 
 
 @pytest.fixture
@@ -146,42 +156,83 @@ def test_pairs_on_two_processes_give_what_one_gives(birds):
     assert one.simulations == two.simulations == 12
 
 
-def test_a_population_search_that_rules_candidates_out_by_one_bird_takes_the_same_steps(birds):
-    """The worst hold of three birds under a cap that binds: the search with
-    every bird of every candidate simulated, and the search that stops
-    simulating a candidate at the first bird that shows it cannot beat the
-    incumbent, take the same steps to the same design, the second on fewer
-    simulations, on one process or two; every ruled-out candidate's bird
-    indeed cannot beat the incumbent it was judged against."""
-    caps = np.full(3, 13.0)
+@pytest.mark.parametrize("size", [3, 1])
+def test_a_search_that_rules_candidates_out_takes_the_same_steps(birds, size):
+    """The worst hold of three birds, or one bird's hold, under a cap that
+    binds: the search with every run whole, and the search that ends a run
+    where it shows that its candidate cannot beat the incumbent (and
+    simulates no more of its birds), take the same steps to the same
+    design, the second on fewer simulations, on one process or two; every
+    ruled-out candidate's whole runs indeed cannot beat the incumbent it was
+    judged against, and a stopped run was stopped against the hold of a
+    design the search stood at."""
+    birds = replace(birds, members=birds.members[:size])
+    caps = np.full(size, 13.0)
     settings = SimpleNamespace(objective="hold", min_hold=None)
-    beats, cannot_beat = pattern_search.judges(birds, caps, settings)
+    beats, rivals = pattern_search.judges(birds, caps, settings)
     d0 = np.full(4, 0.5)
 
-    def searched(test, workers):
-        with Pairs(birds, None, None, workers, test) as pool:
+    def searched(rivals, workers):
+        with Pairs(birds, None, None, workers, rivals) as pool:
             start, = pool.score([d0])
             found = compass(pool.score, d0, start, beats, max_evaluations=40)
         return found, pool.simulations, start
 
     (every, n_every, start), (lazy, n_lazy, _), (lazy2, _, _) = (
-        searched(None, 1), searched(cannot_beat, 1), searched(cannot_beat, 2))
+        searched(None, 1), searched(rivals, 1), searched(rivals, 2))
     moves = [[(t.variable, t.units, t.move, t.taken) for t in f.trials] for f in
              (every, lazy, lazy2)]
     assert moves[0] == moves[1] == moves[2]
     assert np.array_equal(every.d, lazy.d) and every.value.hold == lazy.value.hold
     assert every.value.within(caps) and every.value.hold > start.hold + 0.01
     ruled = [t for t in lazy.trials if t.value.ruled_out_by]
-    assert ruled and n_lazy < n_every - len(ruled)
+    assert ruled and n_lazy <= n_every - (size - 1) * len(ruled)
     # a ruled-out candidate carries the birds it simulated, each its own run
+    stood_at = [start.hold] + [t.value.hold for t in lazy.trials if t.taken]
     for t in ruled:
         members = t.value.population.members
         assert t.value.ruled_out_by in [m.name for m in members]
-        assert [e.hold for e in t.value.members] == [
-            _bird_run(m.space, t.d, None, None).hold for m in members]
+        for m, e in zip(members, t.value.members):
+            cutoff = e.run.summary["cutoff"]
+            assert cutoff.hold in stood_at and cutoff.cap == 13.0
+            assert e.hold == _bird_run(m.space, t.d, None, None, cutoff).hold
+    assert any(e.run.summary["stopped"] for t in ruled for e in t.value.members)
     complete = {tuple(t.d): t.value for t in every.trials}
     assert not any(beats(complete[tuple(t.d)], incumbent)
                    for t, incumbent in judged_against(lazy, start))
+
+
+def test_a_candidate_ruled_out_does_not_win_a_poll_its_whole_run_would_tie(birds, monkeypatch):
+    """A poll whose up step holds 0.6 band longer than the incumbent and
+    whose down step 1.2 band longer: on whole runs the up step wins the
+    poll (the two within the band: up on a tie) and, not beating the
+    incumbent, no move is taken. A candidate is ruled out only by a hold no
+    longer than the incumbent's, not by one within the band of it, so the
+    search that rules candidates out takes no move either."""
+    band, base = pattern_search.HOLD_BAND, 0.5
+    holds = {0.5 + FIRST_STEP * LATTICE: base + 0.6 * band,
+             0.5 - FIRST_STEP * LATTICE: base + 1.2 * band}
+
+    def tie_run(space, d, settings, integrator, cutoff=None):
+        d = np.asarray(d, float)
+        on_axis = np.all(d[1:] == 0.5)
+        hold = holds.get(float(d[0]), base - 0.01) if on_axis else base - 0.01
+        return _stand_in(d, base if np.all(d == 0.5) else hold, FORCE, cutoff)
+    monkeypatch.setattr(pattern_search, "simulate", tie_run)
+    bird = replace(birds, members=birds.members[:1])
+    beats, rivals = pattern_search.judges(bird, np.full(1, 13.0),
+                                          SimpleNamespace(objective="hold", min_hold=None))
+    d0 = np.full(4, 0.5)
+
+    def searched(rivals):
+        with Pairs(bird, None, None, 1, rivals) as pool:
+            start, = pool.score([d0])
+            return compass(pool.score, d0, start, beats, max_evaluations=12)
+
+    whole, ruling = searched(None), searched(rivals)
+    assert [t.taken for t in whole.trials] == [t.taken for t in ruling.trials]
+    assert not any(t.taken for t in whole.trials)
+    assert [t.value.hold for t in ruling.trials[:2]] == [base + 0.6 * band, base + 1.2 * band]
 
 
 def judged_against(found, start):

@@ -146,22 +146,31 @@ def search_table(page: Page, solver: dict) -> None:
     if answered(s):
         screen_table(page, s)
         return
-    birds = any("ruled_out_by" in h for h in solver["history"])
+    ruled = any(h.get("ruled_out_by") for h in solver["history"])
+    birds = any("simulated_hold_times_s" in h for h in solver["history"])
     page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
               f"with every finger under the cap; {s['simulations']} designs simulated, the "
               f"baseline's included, on a budget of {s['max_simulations']} from the start"
               + ("" if s["lattice_optimum"] else ", the budget ending the search") + "."
-              + (f" {s['bird_simulations']} bird simulations: a design's birds are "
-                 "simulated until one shows it cannot beat the design the search stands "
-                 "at (its hold and peak are then those of the birds simulated)."
-                 if birds else ""))
+              + (f" {s['bird_simulations']} bird simulations: a candidate's "
+                 + ("birds are simulated until one shows" if birds else "run ends as soon "
+                    "as it shows")
+                 + " that it cannot beat the design the search stands at (a finger over its "
+                   "limit, or a hold no longer than that design's), and its hold and peak "
+                   "are then those of the runs up to there." if ruled else ""))
+
+    def ruled_out(h: dict) -> str:
+        if not h.get("ruled_out_by"):
+            return ""
+        return (f"{h['ruled_out_by']}: " if birds else "") + (h.get("stopped")
+                                                              or "its whole run")
     page.table([{"simulation": h["iteration"], "step (scaled)": h["radius"],
                  "variable": h["variable"], "move": h["move"],
                  "simulated hold (s)": h["simulated_hold_time_s"],
                  "simulated peak (N)": h["simulated_peak_force_N"],
-                 **({"ruled out by": h.get("ruled_out_by") or ""} if birds else {}),
+                 **({"ruled out by": ruled_out(h)} if ruled else {}),
                  "taken": h["accepted"]} for h in solver["history"]],
                "Pattern search", "history-table")
 

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from collections.abc import Callable
 from math import comb
 
 import numpy as np
@@ -114,6 +115,10 @@ class Trajectory:
     #: fixed-step runs: (largest estimated local error of a step in the
     #: bird's position m, the time s at the end of that step)
     local_error: tuple[float, float] | None = None
+    #: adaptive runs: the trajectory so far -> why to end the run at its last
+    #: record ("": go on); it ends ``ok``, ``stopped`` saying why
+    watch: Callable[["Trajectory"], str] | None = field(default=None, repr=False)
+    stopped: str = ""
 
     def over_budget(self, started: float, budget: float | None, t: float, t_end: float) -> bool:
         """Stop (and say so) once the run has taken longer than ``budget`` s."""
@@ -153,13 +158,14 @@ class Grasp:
 
 
 def integrate(grasp: Grasp, y0: np.ndarray, t_end: float, settings: IntegratorSettings,
-              progress=None) -> Trajectory:
+              progress=None, watch=None) -> Trajectory:
     """Integrate from y0 over [0, t_end]. A finger contact that cannot be
     solved ends the run there: ``ok`` false, the time and finger in
-    ``message`` (the records so far are kept)."""
+    ``message`` (the records so far are kept). ``watch``: see
+    :attr:`Trajectory.watch`."""
     run = {"adaptive": _adaptive, "bdf4": _bdf4}[settings.integrator]
     t0 = time.perf_counter()
-    traj = Trajectory()
+    traj = Trajectory(watch=watch)
     try:
         run(grasp, traj, y0, t_end, settings, progress)
     except ContactFailed as exc:
@@ -263,15 +269,19 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
 
 
 def _keep(grasp: Grasp, traj: Trajectory, record: Record) -> bool:
-    """Append ``record``; False (the run failed, and says where) if the belt
-    would have to pull the bird down to keep it in its belt mode: a lift-off
-    the events missed because the finger forces jumped (a contact changing
-    branch between two evaluations), or friction's Painlevé paradox, which
-    this model has no impulse to resolve."""
+    """Append ``record``; False where the run ends there: its watch ends it
+    (``stopped``), or it failed, saying where, because the belt would have to
+    pull the bird down to keep it in its belt mode: a lift-off the events
+    missed because the finger forces jumped (a contact changing branch
+    between two evaluations), or friction's Painlevé paradox, which this
+    model has no impulse to resolve."""
     traj.records.append(record)
     weight = grasp.dyn.bird.mass * G
     if record.mode == "air" or record.normal >= -SUPPORT_TOL * weight:
-        return True
+        if traj.watch is None or not (reason := traj.watch(traj)):
+            return True
+        traj.stopped, traj.message = reason, f"stopped at t = {record.t:.4f} s: {reason}"
+        return False
     traj.ok = False
     traj.message = (f"the belt pulls the bird down at t = {record.t:.6f} s (N = "
                     f"{record.normal:.3g} N in mode {record.mode}): the run cannot go on "

@@ -76,8 +76,11 @@ class GraspRun:
 
 
 def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = IntegratorSettings(),
-                   contact_nodes: int = 6, reach_filter: bool = True, progress=None) -> GraspRun:
-    """Integrate the symmetric grasp from the bird sitting on the belt at start_x."""
+                   contact_nodes: int = 6, reach_filter: bool = True, progress=None,
+                   watch=None) -> GraspRun:
+    """Integrate the symmetric grasp from the bird sitting on the belt at
+    start_x; ``watch`` (a trajectory -> the reason to end it, or "") may
+    end the run early (design/solvers/grasp/cutoff.py)."""
     t0 = time.perf_counter()
     b, conv = setup.bird, setup.conveyor
     windows = setup_reach_windows(setup) if reach_filter else None
@@ -88,7 +91,7 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     grasp = Grasp(dyn, conv, fingers)
     y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])
     setup_time = time.perf_counter() - t0
-    traj = integrate(grasp, y0, setup.duration, integrator, progress)
+    traj = integrate(grasp, y0, setup.duration, integrator, progress, watch)
     return GraspRun(setup, traj, windows, fingers.solves, fingers.skipped, setup_time)
 
 
@@ -120,26 +123,39 @@ def _union(a, b):
     return out
 
 
+class HoldWindows:
+    """The hold windows (N = 0) of a run's records taken in order: those
+    ``closed`` ((start, end) s) and the ``start`` (s) of one still open (None:
+    the belt supports the bird). A touch-down ends a window even when the
+    bird bounces straight off: the belt's impulse carried it at that
+    instant."""
+
+    def __init__(self):
+        self.closed: list[tuple[float, float]] = []
+        self.start: float | None = None
+
+    def add(self, record, impact: bool) -> None:
+        """The next record; ``impact``: a touch-down at its instant."""
+        if record.mode == "air" and self.start is not None and impact and record.t > self.start:
+            self.closed.append((self.start, record.t))
+            self.start = record.t
+        elif record.mode == "air" and self.start is None:
+            self.start = record.t
+        elif record.mode != "air" and self.start is not None:
+            self.closed.append((self.start, record.t))
+            self.start = None
+
+
 def hold_windows(run: GraspRun) -> list[tuple[float, float]]:
-    """Intervals (s) in which the belt does not support the bird (N = 0). A
-    touch-down ends a window even when the bird bounces straight off: the
-    belt's impulse carried it at that instant. The last window may run to
-    the end of the run (the bird not yet put back)."""
+    """Intervals (s) in which the belt does not support the bird (N = 0)
+    (:class:`HoldWindows`). The last window may run to the end of the run
+    (the bird not yet put back)."""
     recs = run.trajectory.records
     impacts = {t for t, name in run.trajectory.events if name == "touch-down"}
-    out, start = [], None
+    windows = HoldWindows()
     for r in recs:
-        if r.mode == "air" and start is not None and r.t in impacts and r.t > start:
-            out.append((start, r.t))
-            start = r.t
-        elif r.mode == "air" and start is None:
-            start = r.t
-        elif r.mode != "air" and start is not None:
-            out.append((start, r.t))
-            start = None
-    if start is not None:
-        out.append((start, recs[-1].t))
-    return out
+        windows.add(r, r.t in impacts)
+    return windows.closed + ([] if windows.start is None else [(windows.start, recs[-1].t)])
 
 
 def jam(run: GraspRun, validity: dict) -> list[str]:
@@ -204,4 +220,5 @@ def summarise(run: GraspRun) -> dict:
             "time_s": run.trajectory.local_error[1]},
         "ok": run.trajectory.ok,
         "message": run.trajectory.message,
+        "stopped": run.trajectory.stopped or None,
     }

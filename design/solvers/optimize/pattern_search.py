@@ -25,16 +25,20 @@ comparison of two simulated holds or of a peak with the cap flips:
   the optimiser's grid): the cap is decided on the peak force, and a looser
   tolerance can step over a force transient of a few ms at a contact;
 * a budget of simulations ends the search, as deterministically;
-* a design of a population is judged bird by bird: once the incumbent
-  keeps every limit (aggregate ``worst``), a candidate beats it only if
-  every bird stays within its limits and holds longer than the incumbent's
-  worst hold by more than the band, so one bird that does not rules the
-  candidate out. The incumbent's shortest-held bird is simulated first,
+* a candidate is ruled out as soon as one of its runs shows that it cannot
+  beat the incumbent (one bird, or a population's worst hold, once the
+  incumbent keeps every limit): a finger over its limit, or a hold no
+  longer than the incumbent's. That run ends there
+  (design/solvers/grasp/cutoff.py), and a population's other birds are
+  not simulated: the incumbent's shortest-held bird is simulated first,
   alone (it rules most candidates out: the one that limits the incumbent
   limits its neighbours), and only if it does not, the other birds
-  together. The search takes the same steps as with every bird simulated
-  (a candidate ruled out against one incumbent is ruled out against any
-  later, better one), on fewer simulations;
+  together. The search takes the same steps as with every run whole: a
+  ruled-out candidate beats nothing, and its whole runs would not have
+  beaten the incumbent, nor (its hold at most the incumbent's, the other's
+  longer by more than the band) a candidate polled beside it that does; a
+  candidate ruled out against one incumbent is ruled out against any
+  later, better one;
 * the simulations of a poll or an extension (two designs' birds, or one
   design's) are handed out one bird at a time to two processes where there
   are two cores: the same simulations as one process would run, two at
@@ -58,6 +62,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from design.solvers.grasp.cutoff import Cutoff
 from design.solvers.optimize.forked import processes
 from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
@@ -223,8 +228,8 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     say = progress or (lambda message: None)
     population = population_of(space)
     caps = np.broadcast_to(np.asarray(cap, float), (len(population.members),)).copy()
-    beats, cannot_beat = judges(population, caps, settings)
-    pool = Pairs(population, settings, settings.simulator, workers, cannot_beat)
+    beats, rivals = judges(population, caps, settings)
+    pool = Pairs(population, settings, settings.simulator, workers, rivals)
 
     def simulate_all(designs, incumbent=None):
         with profile.phase(SIMULATIONS):
@@ -265,8 +270,9 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
         **({} if len(caps) == 1 else {
             "simulated_hold_times_s": per_bird(population, t.value, "hold"),
-            "simulated_peak_forces_N": per_bird(population, t.value, "peak"),
-            "ruled_out_by": t.value.ruled_out_by}),
+            "simulated_peak_forces_N": per_bird(population, t.value, "peak")}),
+        **({} if settings.objective == "throughput" else {
+            "ruled_out_by": t.value.ruled_out_by, "stopped": stopped(t.value)}),
         **({} if settings.objective != "throughput" else {
             "line_rate_per_min": rate_of(t.value), "keeps_limits": t.value.within(caps),
             "jammed_birds": t.value.shortfall(caps)[1]})}
@@ -287,11 +293,12 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
 def judges(population: Population, caps: np.ndarray, settings: LoopSettings):
     """How the search compares designs: ``beats(a, b)``, in which a
     ruled-out candidate beats nothing and anything else beats it; and, where
-    the population's worst hold counts, ``cannot_beat(incumbent)``: None
-    where the incumbent breaks a limit (then a candidate's every bird
-    counts), else the test of one bird's simulation ``(bird index,
-    Evaluated)`` that rules a candidate out: the bird breaks its limits, or
-    holds no longer than the incumbent's worst hold and the band."""
+    the hold counts (one bird, or the population's worst),
+    ``rivals(incumbent)``: None where the incumbent breaks a limit (then a
+    candidate's every run counts whole), else each bird's
+    :class:`~design.solvers.grasp.cutoff.Cutoff`, the incumbent's hold and
+    the bird's cap: a bird's run that breaks its limits or holds no longer
+    rules the candidate out."""
     def beats(a: Scored, b: Scored) -> bool:
         if a.ruled_out_by or b.ruled_out_by:
             return not a.ruled_out_by
@@ -299,14 +306,28 @@ def judges(population: Population, caps: np.ndarray, settings: LoopSettings):
             return faster(a, b, caps, settings.min_hold, HOLD_BAND)
         return better(a, b, caps, tolerance=0.0, band=HOLD_BAND)
 
-    def cannot_beat(incumbent: Scored):
+    def rivals(incumbent: Scored) -> list[Cutoff] | None:
         if not incumbent.within(caps):
             return None
-        return lambda b, run: not alone(run, population.members[b]).within(caps[b]) \
-            or run.hold <= incumbent.hold + HOLD_BAND
-    lazy = settings.objective != "throughput" and population.aggregate == "worst" \
-        and len(population.members) > 1
-    return beats, cannot_beat if lazy else None
+        return [Cutoff(incumbent.hold, float(cap)) for cap in caps]
+    lazy = settings.objective != "throughput" and (
+        population.aggregate == "worst" or len(population.members) == 1)
+    return beats, rivals if lazy else None
+
+
+def rules_out(run: Evaluated, member, cutoff: Cutoff) -> bool:
+    """Does one bird's run show that its candidate cannot beat ``cutoff``'s
+    rival: ended by it, or over a limit, or holding no longer?"""
+    return bool(run.run.summary.get("stopped")) or run.hold <= cutoff.hold \
+        or not alone(run, member).within(cutoff.cap)
+
+
+def stopped(value: Scored) -> str | None:
+    """Why the run that ruled a candidate out ended early (None: the
+    candidate was not ruled out, or by a whole run)."""
+    return next((e.run.summary.get("stopped") for m, e in
+                 zip(value.population.members, value.members)
+                 if m.name == value.ruled_out_by), None)
 
 
 def per_bird(population: Population, value: Scored, what: str) -> list:
@@ -322,12 +343,14 @@ def per_bird(population: Population, value: Scored, what: str) -> list:
 _SCORING: tuple | None = None
 
 
-def _simulate_slim(job: tuple[np.ndarray, int], scoring: tuple | None = None) -> Evaluated:
-    """Bird ``b``'s simulation of the scaled design ``d`` (``job``), slim, by
-    ``scoring``'s population, settings and integrator (default: the pool's)."""
+def _simulate_slim(job: tuple[np.ndarray, int, Cutoff | None], scoring: tuple | None = None
+                   ) -> Evaluated:
+    """Bird ``b``'s simulation of the scaled design ``d``, ended early against
+    ``cutoff`` (``job``), slim, by ``scoring``'s population, settings and
+    integrator (default: the pool's)."""
     population, settings, integrator = scoring or _SCORING
-    d, b = job
-    return slim(simulate(population.members[b].space, d, settings, integrator))
+    d, b, cutoff = job
+    return slim(simulate(population.members[b].space, d, settings, integrator, cutoff))
 
 
 def slim(run: Evaluated) -> Evaluated:
@@ -347,17 +370,18 @@ class Pairs:
     process is a daemon (a Dask worker's) that may not have children. A
     forked child computes exactly what this process would.
 
-    With ``cannot_beat`` (an incumbent -> a test ``(bird index, Evaluated)
-    -> bool``, or None where the incumbent admits no such test) a
-    candidate's first bird is the incumbent's shortest-held, alone; its
-    other birds are simulated only if that one does not rule it out (the
-    same birds on any number of processes)."""
+    With ``rivals`` (an incumbent -> each bird's Cutoff, or None where the
+    incumbent admits none; :func:`judges`) each run ends where it shows
+    that its candidate cannot beat the incumbent, and a candidate's first
+    bird is the incumbent's shortest-held, alone; its other birds are
+    simulated only if that one does not rule it out (the same birds on any
+    number of processes)."""
 
     def __init__(self, population: Population, settings: LoopSettings, integrator,
-                 workers: int | None, cannot_beat=None):
+                 workers: int | None, rivals=None):
         self.job = (population, settings, integrator)
         self.processes = processes(workers)
-        self.cannot_beat = cannot_beat
+        self.rivals = rivals
         self.pool = None
         #: the birds simulated (one design, one bird each)
         self.simulations = 0
@@ -381,7 +405,7 @@ class Pairs:
             self.pool, _SCORING = None, None
             self.children_cpu_time = _children_cpu() - self._children_before
 
-    def _simulate(self, jobs: list[tuple[np.ndarray, int]]) -> list[Evaluated]:
+    def _simulate(self, jobs: list[tuple[np.ndarray, int, Cutoff | None]]) -> list[Evaluated]:
         self.simulations += len(jobs)
         if self.pool is None or len(jobs) == 1:
             return [_simulate_slim(job, self.job) for job in jobs]
@@ -392,18 +416,20 @@ class Pairs:
         the ``incumbent`` partly, ``ruled_out_by`` the bird that shows it."""
         population = self.job[0]
         birds = range(len(population.members))
-        test = self.cannot_beat(incumbent) if self.cannot_beat and incumbent else None
-        order = sorted(birds, key=lambda b: (incumbent.holds[b], b)) if test else list(birds)
+        cutoffs = self.rivals(incumbent) if self.rivals and incumbent else None
+        order = sorted(birds, key=lambda b: (incumbent.holds[b], b)) if cutoffs else list(birds)
         runs: list[dict] = [{} for _ in designs]
         out: list[Scored | None] = [None] * len(designs)
         while pending := [i for i, o in enumerate(out) if o is None]:
             # a candidate that may be ruled out: its first bird alone, then the rest
             jobs = [(i, b) for i in pending for b in
-                    [b for b in order if b not in runs[i]][:1 if test and not runs[i] else None]]
-            for (i, b), run in zip(jobs, self._simulate([(designs[i], b) for i, b in jobs])):
+                    [b for b in order if b not in runs[i]][:1 if cutoffs and not runs[i] else None]]
+            for (i, b), run in zip(jobs, self._simulate(
+                    [(designs[i], b, cutoffs and cutoffs[b]) for i, b in jobs])):
                 runs[i][b] = run
             for i in pending:
-                ruled = [b for b in order if b in runs[i] and test and test(b, runs[i][b])]
+                ruled = [b for b in order if b in runs[i] and cutoffs and
+                         rules_out(runs[i][b], population.members[b], cutoffs[b])]
                 if ruled or len(runs[i]) == len(order):
                     simulated = [b for b in birds if b in runs[i]]
                     out[i] = Scored(np.asarray(designs[i], float),

@@ -43,6 +43,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from design.solvers.grasp.cutoff import Cutoff
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import GraspRun, simulate_grasp
 from design.solvers.grasp.validity import finger_limits, validity_problems
@@ -258,10 +259,14 @@ class Outcome:
 
 
 def simulate(space: DesignSpace, d: np.ndarray, settings: LoopSettings,
-             integrator: IntegratorSettings | None = None) -> Evaluated:
-    """Simulate the scaled design ``d``; its summary (hold, peak force) is
-    computed here, once, so that a profile counts it with the simulation."""
-    run = simulate_grasp(space.setup(d), integrator or settings.simulator, settings.contact_nodes)
+             integrator: IntegratorSettings | None = None, cutoff: Cutoff | None = None
+             ) -> Evaluated:
+    """Simulate the scaled design ``d``, ended early where it shows it cannot
+    beat ``cutoff``'s rival; its summary (hold, peak force) is computed
+    here, once, so that a profile counts it with the simulation."""
+    setup = space.setup(d)
+    run = simulate_grasp(setup, integrator or settings.simulator, settings.contact_nodes,
+                         watch=cutoff and cutoff.watch(setup))
     run.summary  # noqa: B018  (cached on the run)
     return Evaluated(np.asarray(d, float), run)
 
