@@ -1,7 +1,8 @@
 """The design on the spatial finger model (design/solvers/optimize/model_check.py):
 its runs in the background process are the spatial simulation itself, its
-verdict follows the cap's rule on the spatial baseline, and closing it stops
-a run in progress."""
+verdict follows the cap's rule on the spatial baseline, a second process
+shares its runs while the run waits, and closing it stops a run in
+progress."""
 
 import json
 import subprocess
@@ -10,12 +11,14 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from design.io.design_problem import Cap
 from design.io.scene import load_scene
 from design.run.solve import design_space
 from design.solvers.grasp.simulation import simulate_grasp
+from design.solvers.optimize.forked import processes
 from design.solvers.optimize.model_check import ModelCheck, check_text, compare, spatial_summary
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.trust_region import LOOP_SIMULATOR
@@ -72,10 +75,31 @@ def test_closing_stops_a_run_in_progress():
     check = ModelCheck(LOOP_SIMULATOR)
     check.submit("baseline", Population.of(space), space.scale(space.base_values))
     time.sleep(1.0)                          # the process is importing or running
-    process = check._process
+    process = check._processes[0]
     t0 = time.perf_counter()
     check.close()
     assert process.poll() is not None and time.perf_counter() - t0 < 5.0
+
+
+@pytest.mark.skipif(processes(None) < 2, reason="one core: no second background process")
+def test_a_second_process_takes_the_runs_the_first_has_not_begun_while_the_run_waits():
+    """Three short spatial runs queued, then waited for: a second process
+    starts, each run is claimed by one process only (none left unclaimed,
+    none repeated), and each gives what this process computes."""
+    space = placed_bird(0.02)
+    setups = [space.setup(d) for d in (space.scale(space.base_values), np.full(8, 0.3),
+                                       np.full(8, 0.6))]
+    with ModelCheck(LOOP_SIMULATOR) as check:
+        check.submit_setups("three", setups)
+        runs = check.runs("three")
+        folder = Path(check._folder.name)
+        assert len(check._processes) == 2
+        assert sorted(p.name for p in folder.glob("*.claimed")) == \
+            ["1.claimed", "2.claimed", "3.claimed"] and not list(folder.glob("*.task"))
+    for setup, run in zip(setups, runs):
+        here = spatial_summary(setup, LOOP_SIMULATOR)
+        assert run["hold_time_s"] == here["hold_time_s"]
+        assert run["max_finger_force_N"] == here["max_finger_force_N"]
 
 
 def run(hold: float, peak: float, warnings=()) -> dict:

@@ -14,13 +14,16 @@ is resolved on the spatial baseline's own peak.
 The spatial runs (seconds each on the main problem) go to one background
 process, the baseline's at the start of the run while the optimiser works,
 the optimum's as soon as the design loop has picked it, so that they cost
-the run little wall time on a machine with a free core. The process is a
-fresh interpreter running this module (``python -m``), not a
+the run little wall time on a machine with a free core. Once the run waits
+for them, its own core is free too, and a second background process takes
+the runs the first has not begun (where there are two cores). A process is
+a fresh interpreter running this module (``python -m``), not a
 multiprocessing child: those import the caller's main script again, which
 would run a user's unguarded ``design.api.solve(...)`` script twice. Tasks
-and results pass as pickles through a private temporary folder. A check
-that fails (the simulation raises or ends early, the process dies) fails
-the run: no silent gaps.
+and results pass as pickles through a private temporary folder; a process
+claims a task by renaming its file, so each runs once. A check that fails
+(the simulation raises or ends early, a process dies) fails the run: no
+silent gaps.
 """
 
 from __future__ import annotations
@@ -39,6 +42,7 @@ import numpy as np
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import SPATIAL_NODES, GraspSetup, simulate_grasp
 from design.solvers.grasp.validity import validity_problems
+from design.solvers.optimize.forked import processes
 from design.solvers.optimize.trust_region import CAP_TOLERANCE
 
 #: the model the check runs and the one it checks
@@ -68,9 +72,10 @@ class ModelCheck:
     ``submit(label, population, d)`` queues every bird's run of the scaled
     design d, ``submit_setups(label, setups)`` any scenes' (the robustness
     table's, design/solvers/optimize/robustness.py); ``result(...)`` waits
-    for a baseline's and an optimum's runs and compares them. ``close()``
-    (or the ``with`` block) stops the process, also amid a run (Ctrl-C, a
-    failed case): a simulation still running there is not waited for."""
+    for a baseline's and an optimum's runs and compares them, on a second
+    process while it waits. ``close()`` (or the ``with`` block) stops the
+    processes, also amid a run (Ctrl-C, a failed case): a simulation still
+    running there is not waited for."""
 
     #: how often a wait looks for a result (s)
     POLL = 0.02
@@ -78,9 +83,9 @@ class ModelCheck:
     def __init__(self, integrator: IntegratorSettings):
         self.integrator = integrator
         self._folder = tempfile.TemporaryDirectory(prefix="design-model-check-")
-        self._process: subprocess.Popen | None = None
+        self._processes: list[subprocess.Popen] = []
+        self._tasks: list[Path] = []
         self._runs: dict[str, list[Path]] = {}
-        self._count = 0
 
     def __enter__(self) -> ModelCheck:
         return self
@@ -89,26 +94,31 @@ class ModelCheck:
         self.close()
 
     def close(self) -> None:
-        if self._process is not None:
-            if self._process.poll() is None:
-                self._process.kill()
-                self._process.wait()
-            self._process.stdin.close()
+        for process in self._processes:
+            if process.poll() is None:
+                process.kill()
+                process.wait()
+            process.stdin.close()
         self._folder.cleanup()
 
-    def _worker(self) -> subprocess.Popen:
-        """The background interpreter, started on the first task; it finds
-        this package where this process found it."""
-        if self._process is None:
-            root = str(Path(__file__).resolve().parents[3])
-            env = dict(os.environ)
-            env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
-            log = open(Path(self._folder.name) / "worker.log", "wb")
-            self._process = subprocess.Popen([sys.executable, "-m", __spec__.name],
-                                             stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
-                                             stderr=log, env=env)
-            log.close()
-        return self._process
+    def _start(self) -> None:
+        """One more background interpreter, given every task so far (it
+        skips those claimed); it finds this package where this process
+        found it."""
+        root = str(Path(__file__).resolve().parents[3])
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
+        log = open(Path(self._folder.name) / f"worker{len(self._processes)}.log", "wb")
+        self._processes.append(subprocess.Popen(
+            [sys.executable, "-m", __spec__.name], stdin=subprocess.PIPE,
+            stdout=subprocess.DEVNULL, stderr=log, env=env))
+        log.close()
+        self._send(self._processes[-1], self._tasks)
+
+    @staticmethod
+    def _send(process: subprocess.Popen, tasks: list[Path]) -> None:
+        process.stdin.write("".join(f"{task}\n" for task in tasks).encode())
+        process.stdin.flush()
 
     def submit(self, label: str, population, d: np.ndarray) -> None:
         """Queue the spatial runs of design d (scaled) for every bird, once per label."""
@@ -118,23 +128,30 @@ class ModelCheck:
         """Queue the spatial runs of ``setups``, once per label."""
         if label in self._runs:
             return
-        worker, paths = self._worker(), []
+        tasks = []
         for setup in setups:
-            self._count += 1
-            task = Path(self._folder.name) / f"{self._count}.task"
+            task = Path(self._folder.name) / f"{len(self._tasks) + len(tasks) + 1}.task"
             task.write_bytes(pickle.dumps((setup, self.integrator)))
-            worker.stdin.write(f"{task}\n".encode())
-            worker.stdin.flush()
-            paths.append(task.with_suffix(".result"))
-        self._runs[label] = paths
+            tasks.append(task)
+        self._tasks += tasks
+        if not self._processes:
+            self._start()
+        else:
+            for process in self._processes:
+                self._send(process, tasks)
+        self._runs[label] = [task.with_suffix(".result") for task in tasks]
 
     def _wait(self, path: Path) -> dict:
+        if not path.exists() and len(self._processes) < processes(None):
+            self._start()                       # this process only waits: its core is free
         while not path.exists():
-            if self._process.poll() is not None:
-                log = (Path(self._folder.name) / "worker.log").read_text(errors="replace")
-                raise RuntimeError(f"the spatial check's process ended (exit status "
-                                   f"{self._process.returncode}) before its run "
-                                   f"{path.stem}: {log.strip()[-2000:]}")
+            for k, process in enumerate(self._processes):
+                if process.poll() is not None:
+                    log = (Path(self._folder.name) / f"worker{k}.log").read_text(
+                        errors="replace")
+                    raise RuntimeError(f"the spatial check's process ended (exit status "
+                                       f"{process.returncode}) before its run "
+                                       f"{path.stem}: {log.strip()[-2000:]}")
             time.sleep(self.POLL)
         run = pickle.loads(path.read_bytes())
         if "error" in run:
@@ -214,13 +231,19 @@ def check_text(check: dict) -> str:
 
 def _serve() -> None:
     """The background process: each line of standard input names a task
-    file (a pickled setup and integrator); its :func:`spatial_summary`, or
-    the error, is written beside it as ``.result`` (renamed into place
-    whole, so that a reader never sees half of it)."""
+    file (a pickled setup and integrator), which it claims by renaming it
+    (another process that claimed it first leaves nothing to rename); its
+    :func:`spatial_summary`, or the error, is written beside it as
+    ``.result`` (renamed into place whole, so that a reader never sees half
+    of it)."""
     for line in sys.stdin:
-        task = Path(line.strip())
+        task, claimed = Path(line.strip()), Path(line.strip()).with_suffix(".claimed")
         try:
-            run = spatial_summary(*pickle.loads(task.read_bytes()))
+            task.rename(claimed)
+        except FileNotFoundError:
+            continue
+        try:
+            run = spatial_summary(*pickle.loads(claimed.read_bytes()))
         except Exception as exc:                 # noqa: BLE001  reported by the waiting run
             run = {"error": f"{type(exc).__name__}: {exc}"}
         partial = task.with_suffix(".partial")
