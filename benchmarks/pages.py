@@ -117,7 +117,12 @@ def main_job(path: Path, data: dict) -> list[str]:
                                          "wall (s)": lambda r: r["wall_time_s"],
                                          "CPU (s)": lambda r: r["cpu_time_s"],
                                          "calls": lambda r: r["calls"]})]
-    return section("The main job", "solve --profile-only", path, data, lines)
+    # --profile-only keeps the NLP sizes' date and machine: the job has its own
+    measured = {**data, "measured_at": job.get("measured_at", data.get("measured_at")),
+                "machine": {**data.get("machine", {}),
+                            "load_average_at_start": job["load_average_at_start"],
+                            "load_average_at_end": job["load_average_at_end"]}}
+    return section("The main job", "solve --profile-only", path, measured, lines)
 
 
 def nlp_sizes(path: Path, data: dict) -> list[str]:

@@ -88,6 +88,7 @@ import resource
 import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import replace
+from datetime import datetime, timezone
 from pathlib import Path
 
 import casadi as ca
@@ -360,6 +361,7 @@ def main_job() -> dict:
     print("\nwhere the main job's time went")
     print(profile_text(result["profile"]))
     return {"command": "design solve problems/hold_time.yaml (design.api.solve)",
+            "measured_at": datetime.now(timezone.utc).date().isoformat(),
             "status": result["status"], "verified_hold_time_s": v["hold_time_s"],
             "optimiser_hold_time_s": result["objective"]["hold_time_s"],
             "baseline_hold_time_s": result["baseline"]["hold_time_s"],
