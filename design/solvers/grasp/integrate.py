@@ -29,8 +29,8 @@ reports the largest and fails where one exceeds
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
 from collections.abc import Callable
+from dataclasses import dataclass, field
 from math import comb
 
 import numpy as np
