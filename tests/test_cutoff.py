@@ -33,7 +33,7 @@ def test_a_run_ends_once_its_hold_cannot_beat_the_rival_and_not_before():
     assert hold > 0.3 and whole.summary["stopped"] is None
     ended = _ended(setup, Cutoff(hold, np.inf))
     t = ended.trajectory.records[-1].t
-    assert ended.summary["ok"] and "no longer exceed" in ended.summary["stopped"]
+    assert ended.summary["ok"] and "no longer than the" in ended.summary["stopped"]
     assert _prefix_of(ended, whole)
     assert windows[0][1] <= t and setup.duration - t <= hold
     beaten = _ended(setup, Cutoff(hold - 1e-6, np.inf))

@@ -324,3 +324,33 @@ def test_design_variables_are_shown_in_degrees():
                            "groups.lower.stiffness_scale": 1.5, "conveyor.start_time": 0.2})
     assert starts == {"start": 0, "fingers.4.angle (deg)": pytest.approx(90.0),
                       "groups.lower.stiffness_scale": 1.5, "conveyor.start_time (s)": 0.2}
+
+
+def test_the_search_table_says_where_and_why_a_candidate_s_run_ended():
+    """A pattern search's history with a candidate taken, one whose run a
+    finger over its limit ended (no hold or peak given: they would be the
+    run's up to there) and one ruled out by its whole run."""
+    from design.report.design import search_table
+    from design.report.page import Page
+    step = {"radius": 0.125, "variable": "conveyor.rate", "move": "poll"}
+    solver = {"search": {"rtol": 1e-6, "first_step": 0.125, "lattice": 1 / 64,
+                         "hold_band_s": 1e-4, "simulations": 4, "max_simulations": 150,
+                         "lattice_optimum": True, "bird_simulations": 4},
+              "history": [
+                  {"iteration": 1, **step, "simulated_hold_time_s": 0.41,
+                   "simulated_peak_force_N": 19.1, "accepted": True, "ruled_out_by": None,
+                   "stopped": None},
+                  {"iteration": 2, **step, "simulated_hold_time_s": 0.0,
+                   "simulated_peak_force_N": 19.7, "accepted": False,
+                   "ruled_out_by": "mean-bird-1.80kg",
+                   "stopped": "finger 5b pressed 19.70 N, over its limit 19.60 N, at 1.143 s"},
+                  {"iteration": 3, **step, "simulated_hold_time_s": 0.39,
+                   "simulated_peak_force_N": 18.2, "accepted": False,
+                   "ruled_out_by": "mean-bird-1.80kg", "stopped": None}]}
+    page = Page("search")
+    search_table(page, solver)
+    r = Report(page.render())
+    assert r.column("history-table", "simulated hold (s)") == ["0.41", "—", "0.39"]
+    assert r.column("history-table", "simulated peak (N)") == ["19.1", "—", "18.2"]
+    assert r.column("history-table", "ruled out by") == [
+        "", "finger 5b pressed 19.70 N, over its limit 19.60 N, at 1.143 s", "its whole run"]

@@ -154,12 +154,12 @@ def search_table(page: Page, solver: dict) -> None:
               f"with every finger under the cap; {s['simulations']} designs simulated, the "
               f"baseline's included, on a budget of {s['max_simulations']} from the start"
               + ("" if s["lattice_optimum"] else ", the budget ending the search") + "."
-              + (f" {s['bird_simulations']} bird simulations: a candidate's "
-                 + ("birds are simulated until one shows" if birds else "run ends as soon "
-                    "as it shows")
+              + ((f" {s['bird_simulations']} bird simulations: a candidate's birds are "
+                  "simulated until one shows" if birds else " A candidate's run ends as soon "
+                  "as it shows")
                  + " that it cannot beat the design the search stands at (a finger over its "
-                   "limit, or a hold no longer than that design's), and its hold and peak "
-                   "are then those of the runs up to there." if ruled else ""))
+                   "limit, or a hold no longer than that design's); a run so ended gives no "
+                   "hold or peak (—)." if ruled else ""))
 
     def ruled_out(h: dict) -> str:
         if not h.get("ruled_out_by"):
@@ -168,8 +168,8 @@ def search_table(page: Page, solver: dict) -> None:
                                                               or "its whole run")
     page.table([{"simulation": h["iteration"], "step (scaled)": h["radius"],
                  "variable": h["variable"], "move": h["move"],
-                 "simulated hold (s)": h["simulated_hold_time_s"],
-                 "simulated peak (N)": h["simulated_peak_force_N"],
+                 "simulated hold (s)": None if h.get("stopped") else h["simulated_hold_time_s"],
+                 "simulated peak (N)": None if h.get("stopped") else h["simulated_peak_force_N"],
                  **({"ruled out by": ruled_out(h)} if ruled else {}),
                  "taken": h["accepted"]} for h in solver["history"]],
                "Pattern search", "history-table")

@@ -51,7 +51,7 @@ class Cutoff:
             reach = max([b - a for a, b in windows.closed]
                         + [setup.duration - (t if windows.start is None else windows.start)])
             if reach <= self.hold:
-                return (f"its hold can no longer exceed {self.hold:.4f} s "
-                        f"(at most {reach:.4f} s) at {t:.3f} s")
+                return (f"it can hold at most {reach:.4f} s from {t:.3f} s on, no longer "
+                        f"than the {self.hold:.4f} s to beat")
             return ""
         return reason
