@@ -26,11 +26,12 @@ from design.physics.beam import Finger
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
 from design.solvers.contact import RobustContact
-from design.solvers.contact.belt_continuation import (GRAZE_DEPTH, BeltedContact, Belted,
+from design.solvers.contact.belt_continuation import (EVENT_DEPTH, GRAZE_DEPTH, BeltedContact,
+                                                      Belted,
                                                       Plane, deepest)
 from design.solvers.contact.planar_belt import PlanarBeltContact
 from design.solvers.contact.spatial import FrictionLaw, Quadric, SpatialContact
-from design.solvers.contact.spatial_belt import SpatialBeltContact
+from design.solvers.contact.spatial_belt import SpatialBeltContact, _nodes
 from tests.problems import thesis_finger
 
 LENGTH = 0.152
@@ -413,3 +414,80 @@ def test_a_first_touch_that_pulls_grazes_and_one_that_pulls_again_fails_the_step
     assert grazed.mode == "free" and grazed.graze == GRAZE_DEPTH
     again = replace(free, graze=GRAZE_DEPTH)
     assert _Scripted(script)._step(again, again, 1.0) is None
+
+
+class _Line(BeltedContact):
+    """A continuation along one parameter p (the bird's first entry): the
+    bird touches the finger at p = 0.3 and every solve succeeds; the
+    parameters of each solve are kept."""
+
+    TOUCH = 0.3
+    n_bird = 1
+
+    def __init__(self):
+        super().__init__()
+        self.solved_at = []
+
+    def _newton(self, state):
+        self.solved_at.append(float(state.bird[0]))
+        return state
+
+    def depth(self, state, kind):
+        return state.bird[0] - self.TOUCH if kind == "bird" else -1.0
+
+    def event(self, state):
+        if state.mode == "belt" and self.depth(state, "bird") > 0.0:
+            return "bird", self.depth(state, "bird")
+        return None
+
+    def switch(self, state, kind):
+        return replace(state, mode="interior+belt")
+
+
+def line_state(p: float, friction: float = 0.0) -> Belted:
+    return Belted("belt", np.zeros(1), np.array([p]), np.array([friction]),
+                  Plane(np.array([0.0, 1.0]), 0.0), np.zeros(1))
+
+
+def test_past_a_located_contact_the_rest_of_the_step_is_taken_at_once():
+    """A contact starting inside a continuation step is located (within
+    EVENT_DEPTH of where it starts), the finger switched into it there, and
+    the rest of the step then taken in one solve, as the step itself was
+    first tried: the short steps that located the contact were the event's,
+    not the path's."""
+    line = _Line()
+    state, msg = line._path(line_state(0.0), line._params(line_state(1.0)), exact=True)
+    assert state.mode == "interior+belt" and state.bird[0] == 1.0 and msg == ""
+    touch = [p for p in line.solved_at if 0.0 < p - line.TOUCH <= EVENT_DEPTH]
+    assert touch, "the contact is located where it starts"
+    after = line.solved_at[line.solved_at.index(touch[0]) + 1:]
+    assert after == [touch[0], 1.0]     # the switched solve at the touch, then the rest
+
+
+def test_a_step_a_contact_starts_in_moves_the_friction_with_the_bird():
+    """When a contact starts inside the whole step (not a failed solve), the
+    step is continued on its own path, the friction law moving with the bird,
+    not the bird under the old law first: no solve combines the bird's new
+    place with the old law."""
+    line = _Line()
+    state, _ = line._follow(line_state(0.0, friction=0.0), line_state(1.0, friction=0.4))
+    assert state.mode == "interior+belt" and state.friction[0] == 0.4
+    assert line.solved_at[-1] == 1.0
+    assert line.solved_at.count(1.0) == 2    # the whole step tried, then the path's last
+
+
+def test_a_rod_state_split_where_the_bird_touches_and_joined_again_is_itself():
+    """Switching a finger on the belt into contact with the bird splits its
+    rod state at the touch, u = L / l, into two segments (the second in the
+    first's end frame); the release joins them. For a state polynomial in u
+    of the collocation's degree (frame and moments quartics) both are
+    exact: the join of the split is the state (1e-13)."""
+    _, _, spatial = solvers("thesis")
+    nodes = _nodes(spatial.contact.widths, spatial.tau)
+    # frame and moments quartics in u (the split's rotations are linear in them)
+    coefficients = np.random.default_rng(5).normal(size=(7, 5))
+    coefficients[0, 0] += 3.0                    # the frame near the identity
+    w = (coefficients @ nodes ** np.arange(5)[:, None]).T.ravel()
+    for u in (0.23, 0.5, 0.81):
+        first, second = spatial._split(w, u)
+        np.testing.assert_allclose(spatial._join(first, second, u), w, atol=1e-13)

@@ -8,9 +8,11 @@ bird-only ``interior`` and ``tip``, and the belt modes ``belt``,
 ``tip+belt`` and ``interior+belt``.
 
 From a solved state the bird, the belt and both friction laws are moved to
-their new values in steps that halve on failure and double on success
-(first the geometry under the old laws, then the laws, as the bird-only
-solvers do). After every step the contacts are checked:
+their new values in one step; where Newton cannot take it, in steps that
+halve on failure and double on success (first the geometry under the old
+laws, then the laws, as the bird-only solvers do); where a contact starts
+inside it, along its own path to where the contact starts and on in one
+step from there. After every step the contacts are checked:
 
 * a contact whose normal force would pull lets go;
 * the tip passing below the belt, or the finger entering the bird, starts a
@@ -247,6 +249,13 @@ class BeltedContact:
         new = self._step(state, whole, 1.0)
         if isinstance(new, Belted):
             return replace(new, held=1.0), ""
+        if isinstance(new, tuple):
+            # a contact starts inside the step: located on the whole step's path
+            # (the two stages below are for a step Newton cannot take)
+            located, _ = self._path(state, self._params(whole), exact=True,
+                                    h=self._to_event(state, new, 1.0))
+            if located is not None:
+                return located, ""
         geometry = replace(state, bird=target.bird, plane=target.plane)
         state, msg = self._path(state, self._params(geometry), exact=True)
         if state is None:
@@ -254,31 +263,30 @@ class BeltedContact:
         laws = replace(state, friction=target.friction, belt=target.belt)
         return self._path(state, self._params(laws), exact=False)
 
-    def _path(self, state: Belted, end: np.ndarray, exact: bool) -> tuple[Belted | None, str]:
-        """From ``state`` to the parameters ``end`` in adaptive steps, with
-        contact events. ``exact`` false: stop at the last equilibrium before
-        a fold (``held`` the share carried)."""
+    def _path(self, state: Belted, end: np.ndarray, exact: bool, h: float = 1.0
+              ) -> tuple[Belted | None, str]:
+        """From ``state`` to the parameters ``end`` in adaptive steps (the
+        first ``h`` of the way), with contact events. ``exact`` false: stop at
+        the last equilibrium before a fold (``held`` the share carried)."""
         start = self._params(state)
         if np.array_equal(start, end):
             return state, ""
-        t, h = 0.0, 1.0
+        t = 0.0
         for _ in range(self.max_steps):
             if t >= 1.0:
                 return replace(state, held=1.0), ""
             t_new = min(1.0, t + h)
             new = self._step(state, self._moved(state, start + t_new * (end - start)), h)
             if isinstance(new, Belted):
-                state, t, h = new, t_new, min(2 * h, 1.0)
+                # past a located event the short step was the event's, not the
+                # path's: the rest is tried at once, as the first step was
+                grow = 1.0 if new.mode != state.mode else 2 * h
+                state, t, h = new, t_new, min(grow, 1.0)
                 continue
             if new == "base":
                 return None, BASE_REACHED
             if isinstance(new, tuple):
-                # a contact starts inside the step, ``depth`` deep at its end: aim
-                # just past the crossing, where the depth, near linear in the
-                # step, passes EVENT_DEPTH / 2 (a secant from the clearance now)
-                _, kind, depth = new
-                before = self.excess(state, kind)
-                h *= (-before + EVENT_DEPTH / 2) / (depth - before) if before < 0.0 else 0.5
+                h = self._to_event(state, new, h)
                 continue
             h /= 2
             if h < 1e-7:
@@ -286,6 +294,15 @@ class BeltedContact:
                     return None, f"continuation stalled at {t:.6f} of the step"
                 return replace(state, held=t), ""
         return None, f"no convergence in {self.max_steps} continuation steps"
+
+    def _to_event(self, state: Belted, located: tuple, h: float) -> float:
+        """A step of h from ``state`` at whose end a contact has started
+        (``located``: ("locate", kind, depth), ``depth`` m deep there),
+        shortened to just past the crossing: where the depth, near linear in
+        the step, passes EVENT_DEPTH / 2 (a secant from the clearance now)."""
+        _, kind, depth = located
+        before = self.excess(state, kind)
+        return h * ((-before + EVENT_DEPTH / 2) / (depth - before) if before < 0.0 else 0.5)
 
     def _step(self, state: Belted, at: Belted, h: float):
         """Solve at the parameters of ``at`` from ``state`` (a step of relative

@@ -260,7 +260,7 @@ class SpatialBeltContact(BeltedContact):
         at = _unit(_evaluate(w, widths, self.tau, np.array([u]))[:4, 0])
         second = _evaluate(w, widths, self.tau, u + (1.0 - u) * _nodes(self.widths2, self.tau))
         back = _conjugate(at)
-        second[:4] = np.column_stack([_multiply(back, q) for q in second[:4].T])
+        second[:4] = _multiply(back, second[:4])
         second[4:] = quaternion_rotation(at).T @ second[4:] * (1.0 - u)
         return first.T.ravel(), second.T.ravel()
 
@@ -274,7 +274,7 @@ class SpatialBeltContact(BeltedContact):
         out[:, inner] = _evaluate(w1, widths, self.tau, nodes[inner] / u)
         out[4:, inner] /= u
         outer = _evaluate(w2, self.widths2, self.tau, (nodes[~inner] - u) / (1.0 - u))
-        out[:4, ~inner] = np.column_stack([_multiply(end, q) for q in outer[:4].T])
+        out[:4, ~inner] = _multiply(end, outer[:4])
         out[4:, ~inner] = quaternion_rotation(end) @ outer[4:] / (1.0 - u)
         return out.T.ravel()
 
@@ -318,16 +318,16 @@ def _evaluate(w: np.ndarray, widths: np.ndarray, tau: np.ndarray, u: np.ndarray)
     """The collocated state (states per node, n) at u in [0, 1], by each
     interval's Lagrange polynomial through its d + 1 nodes."""
     d1 = tau.size
-    states = w.reshape(widths.size * d1, -1).T
+    states = w.reshape(widths.size, d1, -1)
     edges = np.concatenate([[0.0], np.cumsum(widths)])
-    out = np.zeros((states.shape[0], u.size))
-    for i, x in enumerate(u):
-        j = int(np.clip(np.searchsorted(edges, x, side="right") - 1, 0, widths.size - 1))
-        s = (x - edges[j]) / widths[j]
-        basis = np.array([np.prod([(s - tau[r]) / (tau[k] - tau[r]) for r in range(d1) if r != k])
-                          for k in range(d1)])
-        out[:, i] = states[:, j * d1:(j + 1) * d1] @ basis
-    return out
+    j = np.clip(np.searchsorted(edges, u, side="right") - 1, 0, widths.size - 1)
+    s = (u - edges[j]) / widths[j]
+    # basis[i, k] = Π_{r≠k} (s_i - τ_r) / (τ_k - τ_r): the r = k factor set to 1
+    own = np.eye(d1, dtype=bool)
+    gaps = np.where(own, 1.0, tau[:, None] - tau[None, :])
+    ratios = (s[:, None, None] - tau[None, None, :]) / gaps
+    basis = np.where(own, 1.0, ratios).prod(axis=2)
+    return np.einsum("ikn,ik->ni", states[j], basis)
 
 
 def _unit(q: np.ndarray) -> np.ndarray:
@@ -335,9 +335,12 @@ def _unit(q: np.ndarray) -> np.ndarray:
 
 
 def _multiply(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Quaternion product a ⊗ b, (w, x, y, z)."""
-    w1, v1, w2, v2 = a[0], a[1:], b[0], b[1:]
-    return np.concatenate([[w1 * w2 - v1 @ v2], w1 * v2 + w2 * v1 + np.cross(v1, v2)])
+    """Quaternion products a ⊗ b, (w, x, y, z): a (4,), b (4,) or (4, n)."""
+    w1, (x1, y1, z1), w2, (x2, y2, z2) = a[0], a[1:], b[0], b[1:]
+    return np.array([w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+                     w1 * x2 + w2 * x1 + y1 * z2 - z1 * y2,
+                     w1 * y2 + w2 * y1 + z1 * x2 - x1 * z2,
+                     w1 * z2 + w2 * z1 + x1 * y2 - y1 * x2])
 
 
 def _conjugate(q: np.ndarray) -> np.ndarray:
