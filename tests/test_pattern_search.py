@@ -28,7 +28,7 @@ def quadratic(d, noise: float = 0.0):
 
 
 def run(d0, noise=0.0, band=1e-6, **kw):
-    def evaluate_many(designs, incumbent):
+    def evaluate_many(designs, incumbent, ahead):
         return [quadratic(d, noise) for d in designs]
     return compass(evaluate_many, np.asarray(d0, float), quadratic(d0, noise),
                    lambda a, b: a > b + band, **kw)
@@ -176,13 +176,18 @@ def test_a_search_that_rules_candidates_out_takes_the_same_steps(birds, size):
         with Pairs(birds, None, None, workers, rivals) as pool:
             start, = pool.score([d0])
             found = compass(pool.score, d0, start, beats, max_evaluations=40)
-        return found, pool.simulations, start
+        return found, pool, start
 
-    (every, n_every, start), (lazy, n_lazy, _), (lazy2, _, _) = (
+    (every, every_pool, start), (lazy, lazy_pool, _), (lazy2, pool2, _) = (
         searched(None, 1), searched(rivals, 1), searched(rivals, 2))
+    n_every, n_lazy = every_pool.simulations, lazy_pool.simulations
     moves = [[(t.variable, t.units, t.move, t.taken) for t in f.trials] for f in
              (every, lazy, lazy2)]
     assert moves[0] == moves[1] == moves[2]
+    # on two processes, runs started ahead (the next poll's) change nothing recorded
+    assert pool2.ran_ahead["used"] > 0 and pool2.simulations == n_lazy
+    assert [(t.value.holds.tolist(), t.value.ruled_out_by) for t in lazy.trials] == \
+        [(t.value.holds.tolist(), t.value.ruled_out_by) for t in lazy2.trials]
     assert np.array_equal(every.d, lazy.d) and every.value.hold == lazy.value.hold
     assert every.value.within(caps) and every.value.hold > start.hold + 0.01
     ruled = [t for t in lazy.trials if t.value.ruled_out_by]
@@ -233,6 +238,24 @@ def test_a_candidate_ruled_out_does_not_win_a_poll_its_whole_run_would_tie(birds
     assert [t.taken for t in whole.trials] == [t.taken for t in ruling.trials]
     assert not any(t.taken for t in whole.trials)
     assert [t.value.hold for t in ruling.trials[:2]] == [base + 0.6 * band, base + 1.2 * band]
+
+
+def test_a_run_started_ahead_against_another_incumbent_is_not_used(birds):
+    """A run started ahead is used only by a call that asks for the same
+    design against the same incumbent: asked for against another, the
+    design is simulated again, against that one, and the run ahead is
+    dropped."""
+    bird = replace(birds, members=birds.members[:1])
+    _, rivals = pattern_search.judges(bird, np.full(1, 13.0),
+                                      SimpleNamespace(objective="hold", min_hold=None))
+    d = np.full(4, 0.6)
+    with Pairs(bird, None, None, 2, rivals) as pool:
+        first, second = pool.score([np.full(4, 0.5), np.full(4, 0.55)])
+        pool.score([np.full(4, 0.4)], first, ahead=[d])
+        asked, = pool.score([d], second)
+    assert first.hold != second.hold
+    assert asked.members[0].run.summary["cutoff"].hold == second.hold
+    assert pool.ran_ahead == {"used": 0, "unused": 1}
 
 
 def judged_against(found, start):

@@ -40,9 +40,11 @@ comparison of two simulated holds or of a peak with the cap flips:
   candidate ruled out against one incumbent is ruled out against any
   later, better one;
 * the simulations of a poll or an extension (two designs' birds, or one
-  design's) are handed out one bird at a time to two processes where there
-  are two cores: the same simulations as one process would run, two at
-  once.
+  design's) are handed out one bird at a time to two forked processes
+  where there are two cores, and a core they leave free starts on the next
+  poll's first runs, as they would be asked for if this evaluation moves
+  nothing (design/solvers/optimize/ahead.py): the same simulations as one
+  process would run, and the same record.
 
 The search's claim for its design is its own simulation of it; the
 verification simulates it again at 4x finer resolution (steps a quarter of
@@ -55,7 +57,6 @@ simulations agree on, and a claim that cannot be made would fail it.
 from __future__ import annotations
 
 import copy
-import multiprocessing
 import resource
 import time
 from dataclasses import dataclass, replace
@@ -63,6 +64,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from design.solvers.grasp.cutoff import Cutoff
+from design.solvers.optimize.ahead import Ahead
 from design.solvers.optimize.forked import processes
 from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
@@ -111,9 +113,10 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     """The coordinate search of the module's docstring on the lattice
     ``clip(d0 + LATTICE * k, 0, 1)`` (scaled variables, integer ``k``).
 
-    ``evaluate_many(designs, incumbent)`` gives the values of a list of
-    designs (the caller may evaluate them in parallel; a value that cannot
-    beat the ``incumbent``'s may be marked ``ruled_out_by`` and left
+    ``evaluate_many(designs, incumbent, ahead)`` gives the values of a list
+    of designs (the caller may evaluate them in parallel, and start on
+    ``ahead``, the designs it will probably be asked for next; a value that
+    cannot beat the ``incumbent``'s may be marked ``ruled_out_by`` and left
     partial), ``value0`` is ``d0``'s;
     ``beats(a, b)`` says whether value a is better than b; a design that is
     not ``allowed`` is not tried; ``moved(trial, count)`` hears of every
@@ -134,13 +137,19 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
         moved_k[i] = min(max(k[i] + units, lo[i]), hi[i])
         return tuple(moved_k)
 
+    def unseen(points) -> list[tuple]:
+        return [p for p in dict.fromkeys(points) if p not in seen]
+
     def evaluate(tried: list[tuple], i: int, move: str) -> list:
         """The values of ``tried``'s points ((k, units) pairs), the unseen ones
-        evaluated together, as many as the budget allows (None beyond it)."""
-        new = [p for p in dict.fromkeys(p for p, _ in tried) if p not in seen]
-        new = new[:max(0, max_evaluations - len(seen))]
+        evaluated together, as many as the budget allows (None beyond it);
+        the next poll's points, should this evaluation move nothing, go
+        with them as the ones probably asked for next."""
+        new = unseen(p for p, _ in tried)[:max(0, max_evaluations - len(seen))]
         if new:
-            for p, v in zip(new, evaluate_many([point(p) for p in new], seen[k])):
+            room = max(0, max_evaluations - len(seen) - len(new))
+            ahead = [point(p) for p in upcoming(i)][:room]
+            for p, v in zip(new, evaluate_many([point(p) for p in new], seen[k], ahead)):
                 seen[p] = v
                 trial_at[p] = Trial(point(p), v, i, dict(tried)[p], move)
                 trials.append(trial_at[p])
@@ -159,11 +168,25 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     def valid(t, k) -> bool:
         return t != k and allowed(point(t))
 
-    k, units, cut = (0,) * len(d0), FIRST_STEP, False
+    def upcoming(i: int) -> list[tuple]:
+        """The unseen points of the next poll that has any after variable
+        i's, should the search stay where it is (a sweep without a move
+        halves the step)."""
+        n = len(d0)
+        for j in range(i + 1, i + 1 + n):
+            size = units if j < n or any_move else units // 2
+            if size < 1:
+                return []
+            new = unseen(t for u in (size, -size) if valid(t := step(k, j % n, u), k))
+            if new:
+                return new
+        return []
+
+    k, units, cut, any_move = (0,) * len(d0), FIRST_STEP, False, False
 
     def sweeps():
         """Poll and extend until the step falls below one unit or the budget ends."""
-        nonlocal k, units, cut
+        nonlocal k, units, cut, any_move
         while units >= 1 and len(seen) < max_evaluations:
             any_move, cut = False, False
             for i in range(len(d0)):
@@ -231,9 +254,9 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     beats, rivals = judges(population, caps, settings)
     pool = Pairs(population, settings, settings.simulator, workers, rivals)
 
-    def simulate_all(designs, incumbent=None):
+    def simulate_all(designs, incumbent=None, ahead=()):
         with profile.phase(SIMULATIONS):
-            return pool.score(designs, incumbent)
+            return pool.score(designs, incumbent, ahead)
 
     d0 = population.space.scale(population.space.base_values)
     allowed = allowed_by(population.space, rules)
@@ -282,7 +305,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
                   "simulations": len(found.trials) + 1 + (start is not None),
                   "bird_simulations": pool.simulations,
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
-                  "processes": pool.processes,
+                  "processes": pool.processes, "runs_ahead": pool.ran_ahead,
                   "processes_cpu_time_s": pool.children_cpu_time,
                   "caps_N": caps_value(caps)}
     out.trials = found.trials
@@ -353,6 +376,12 @@ def _simulate_slim(job: tuple[np.ndarray, int, Cutoff | None], scoring: tuple | 
     return slim(simulate(population.members[b].space, d, settings, integrator, cutoff))
 
 
+def _job_key(job: tuple[np.ndarray, int, Cutoff | None]) -> tuple:
+    """What a job computes: the design's bits, the bird and the rival."""
+    d, b, cutoff = job
+    return np.asarray(d, float).tobytes(), b, cutoff
+
+
 def slim(run: Evaluated) -> Evaluated:
     """A bird's simulation without its trajectories (tens of MB each): what a
     search decides by (the run's setup and summary) passes between processes."""
@@ -368,7 +397,9 @@ class Pairs:
     extension's two) for every bird, one bird of one design at a time, in
     forked processes, or here where there is one core, no ``fork``, or this
     process is a daemon (a Dask worker's) that may not have children. A
-    forked child computes exactly what this process would.
+    forked child computes exactly what this process would. A core left free
+    starts the runs the search will probably ask for next (``ahead``),
+    each used only if asked for as it ran: the same design, bird and rival.
 
     With ``rivals`` (an incumbent -> each bird's Cutoff, or None where the
     incumbent admits none; :func:`judges`) each run ends where it shows
@@ -382,7 +413,10 @@ class Pairs:
         self.job = (population, settings, integrator)
         self.processes = processes(workers)
         self.rivals = rivals
-        self.pool = None
+        self.pool: Ahead | None = None
+        #: runs started ahead that were then asked for, and those never asked
+        #: for (None: no forked processes)
+        self.ran_ahead: dict | None = None
         #: the birds simulated (one design, one bird each)
         self.simulations = 0
         #: the CPU time (s) of the forked processes, once they have ended
@@ -394,38 +428,46 @@ class Pairs:
         if self.processes > 1:
             _SCORING = self.job
             self._children_before = _children_cpu()
-            self.pool = multiprocessing.get_context("fork").Pool(self.processes)
+            self.pool = Ahead(_simulate_slim, _job_key, self.processes)
         return self
 
     def __exit__(self, *exc) -> None:
         global _SCORING
         if self.pool is not None:
-            self.pool.terminate()
-            self.pool.join()
+            self.pool.close()
+            self.ran_ahead = {"used": self.pool.used, "unused": self.pool.unused}
             self.pool, _SCORING = None, None
             self.children_cpu_time = _children_cpu() - self._children_before
 
-    def _simulate(self, jobs: list[tuple[np.ndarray, int, Cutoff | None]]) -> list[Evaluated]:
+    def _simulate(self, jobs: list[tuple[np.ndarray, int, Cutoff | None]], ahead=()
+                  ) -> list[Evaluated]:
         self.simulations += len(jobs)
-        if self.pool is None or len(jobs) == 1:
+        if self.pool is None:
             return [_simulate_slim(job, self.job) for job in jobs]
-        return self.pool.map(_simulate_slim, jobs, chunksize=1)
+        return self.pool.run(jobs, ahead)
 
-    def score(self, designs: list, incumbent: Scored | None = None) -> list[Scored]:
+    def score(self, designs: list, incumbent: Scored | None = None, ahead: list = ()
+              ) -> list[Scored]:
         """Each design scored for the population; candidates that cannot beat
-        the ``incumbent`` partly, ``ruled_out_by`` the bird that shows it."""
+        the ``incumbent`` partly, ``ruled_out_by`` the bird that shows it.
+        ``ahead``: designs the caller will probably score next against the
+        same incumbent, whose first runs a free core may start meanwhile."""
         population = self.job[0]
         birds = range(len(population.members))
         cutoffs = self.rivals(incumbent) if self.rivals and incumbent else None
         order = sorted(birds, key=lambda b: (incumbent.holds[b], b)) if cutoffs else list(birds)
+
+        def first(b_done: dict) -> list[int]:
+            """A candidate's birds to simulate next: if it may be ruled out, its
+            first bird alone, then the rest."""
+            return [b for b in order if b not in b_done][:1 if cutoffs and not b_done else None]
+        later = [(d, b, cutoffs and cutoffs[b]) for d in ahead for b in first({})]
         runs: list[dict] = [{} for _ in designs]
         out: list[Scored | None] = [None] * len(designs)
         while pending := [i for i, o in enumerate(out) if o is None]:
-            # a candidate that may be ruled out: its first bird alone, then the rest
-            jobs = [(i, b) for i in pending for b in
-                    [b for b in order if b not in runs[i]][:1 if cutoffs and not runs[i] else None]]
+            jobs = [(i, b) for i in pending for b in first(runs[i])]
             for (i, b), run in zip(jobs, self._simulate(
-                    [(designs[i], b, cutoffs and cutoffs[b]) for i, b in jobs])):
+                    [(designs[i], b, cutoffs and cutoffs[b]) for i, b in jobs], later)):
                 runs[i][b] = run
             for i in pending:
                 ruled = [b for b in order if b in runs[i] and cutoffs and

@@ -1,0 +1,143 @@
+"""Simulations in forked processes, one process each, some run ahead.
+
+A pattern search evaluates its points a poll at a time: two simulations,
+a decision, the next two. Where one of them ends early (a candidate ruled
+out) its core would wait for the other. Here each simulation is a forked
+process of its own, at most one per core at a time, and while the ones
+asked for run, a free core starts one the caller will probably ask for
+next (the next poll's, if this one moves nothing). A simulation run ahead
+is the computation it would be when asked for (the same job: design, bird
+and rival), so what the caller gets, and decides, does not depend on
+whether it ran ahead; one no longer wanted is killed.
+
+A forked process computes exactly what this one would: it starts from this
+process's state at the fork, with its built functions.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+from collections.abc import Callable, Hashable, Sequence
+from multiprocessing.connection import wait
+
+
+class _Forked:
+    """One call ``fn(job)`` in a forked process."""
+
+    def __init__(self, context, fn: Callable, job):
+        self._receive, send = context.Pipe(duplex=False)
+        self._process = context.Process(target=_call, args=(fn, job, send), daemon=True)
+        self._process.start()
+        send.close()
+        self._outcome = None
+
+    @property
+    def connection(self):
+        return self._receive
+
+    def done(self) -> bool:
+        return self._outcome is not None or self._receive.poll()
+
+    def value(self):
+        """The call's value (waiting for it), or its exception raised here."""
+        if self._outcome is None:
+            try:
+                self._outcome = self._receive.recv()
+            except EOFError:
+                self._outcome = ("error", RuntimeError(
+                    f"a simulation's process ended without an answer "
+                    f"(exit code {self._process.exitcode})"))
+            self._process.join()
+            self._receive.close()
+        kind, value = self._outcome
+        if kind == "error":
+            raise value
+        return value
+
+    def kill(self) -> None:
+        if self._outcome is None:
+            self._process.kill()
+            self._process.join()
+            self._receive.close()
+            self._outcome = ("error", RuntimeError("killed: no longer wanted"))
+
+
+def _call(fn: Callable, job, send) -> None:
+    try:
+        outcome = ("value", fn(job))
+    except BaseException as exc:  # noqa: BLE001  (handed to the caller, raised there)
+        outcome = ("error", exc)
+    try:
+        send.send(outcome)
+    except Exception as exc:  # noqa: BLE001  (an exception that does not pickle)
+        send.send(("error", RuntimeError(f"{type(outcome[1]).__name__}: {outcome[1]} "
+                                         f"(not passed on: {exc})")))
+    send.close()
+
+
+class Ahead:
+    """Calls of ``fn`` on ``processes`` cores, each in a forked process;
+    ``key(job)`` names what a job computes (equal keys, equal values)."""
+
+    def __init__(self, fn: Callable, key: Callable[[object], Hashable], processes: int):
+        self.fn, self.key, self.processes = fn, key, processes
+        self._context = multiprocessing.get_context("fork")
+        #: jobs run ahead, by key, running or done, not yet asked for
+        self._ahead: dict[Hashable, _Forked] = {}
+        #: jobs run ahead and then asked for, and those never asked for
+        self.used = self.unused = 0
+        self._live: set[_Forked] = set()
+
+    def run(self, jobs: Sequence, ahead: Sequence = ()) -> list:
+        """``[fn(job) for job in jobs]``; while they run, a free core starts
+        the jobs of ``ahead`` in turn (a later call's, probably). Jobs run
+        ahead that are neither in ``jobs`` nor in ``ahead`` are killed."""
+        try:
+            return self._run(jobs, ahead)
+        except BaseException:
+            self.close()
+            raise
+
+    def _run(self, jobs: Sequence, ahead: Sequence) -> list:
+        keys = [self.key(job) for job in jobs]
+        wanted = set(keys) | {self.key(job) for job in ahead}
+        for k in [k for k in self._ahead if k not in wanted]:
+            unwanted = self._ahead.pop(k)
+            unwanted.kill()
+            self._live.discard(unwanted)
+            self.unused += 1
+        forked: list[_Forked | None] = [self._ahead.pop(k, None) for k in keys]
+        self.used += sum(f is not None for f in forked)
+        todo = [i for i, f in enumerate(forked) if f is None]
+        later = [job for job in ahead if self.key(job) not in self._ahead
+                 and self.key(job) not in keys]
+        while True:
+            running = [f for f in [*forked, *self._ahead.values()]
+                       if f is not None and not f.done()]
+            while len(running) < self.processes and (todo or later):
+                if todo:
+                    i = todo.pop(0)
+                    forked[i] = self._fork(jobs[i])
+                    running.append(forked[i])
+                else:
+                    job = later.pop(0)
+                    self._ahead[self.key(job)] = self._fork(job)
+                    running.append(self._ahead[self.key(job)])
+            if not todo and all(f.done() for f in forked):
+                values = [f.value() for f in forked]
+                self._live -= set(forked)
+                return values
+            wait([f.connection for f in running])
+
+    def _fork(self, job) -> _Forked:
+        forked = _Forked(self._context, self.fn, job)
+        self._live.add(forked)
+        return forked
+
+    def close(self) -> None:
+        """Kill every process still running (a failed or interrupted call's,
+        and those run ahead)."""
+        for forked in self._live:
+            forked.kill()
+        self._live.clear()
+        self._ahead.clear()

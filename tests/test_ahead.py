@@ -1,0 +1,69 @@
+"""Simulations in forked processes, some run ahead (design/solvers/optimize/
+ahead.py): what a call returns does not depend on what ran ahead; a job
+run ahead is not run again when asked for; one no longer wanted is killed,
+not waited for; a job's exception reaches the caller."""
+
+import os
+import time
+
+import pytest
+
+from design.solvers.optimize.ahead import Ahead
+
+
+def stamped(job):
+    """The job, the process that ran it and when it began (monotonic s);
+    a job ("sleep", s) first sleeps s seconds, ("fail", _) raises."""
+    began = time.monotonic()
+    kind, value = job
+    if kind == "sleep":
+        time.sleep(value)
+    if kind == "fail":
+        raise ValueError(f"job {value} failed")
+    return job, os.getpid(), began
+
+
+def key(job):
+    return job
+
+
+@pytest.fixture
+def ahead():
+    runner = Ahead(stamped, key, processes=2)
+    yield runner
+    runner.close()
+
+
+def test_jobs_run_in_forked_processes_in_order(ahead):
+    jobs = [("sleep", 0.05 * (3 - n)) for n in range(3)]
+    values = ahead.run(jobs)
+    assert [v[0] for v in values] == jobs
+    pids = {v[1] for v in values}
+    assert len(pids) == 3 and os.getpid() not in pids
+
+
+def test_a_job_run_ahead_is_used_when_asked_for_not_run_again(ahead):
+    """While a slow job runs, the free core starts the job asked for next;
+    the next call returns that run (begun before the call), not a new one."""
+    later = ("sleep", 0.0)
+    ahead.run([("sleep", 0.5)], ahead=[later])
+    asked = time.monotonic()
+    (job, _, began), = ahead.run([later])
+    assert job == later and began < asked
+    assert ahead.used == 1 and ahead.unused == 0
+
+
+def test_a_job_run_ahead_and_not_wanted_is_killed_not_waited_for(ahead):
+    """A job run ahead that the next call neither asks for nor runs ahead is
+    killed: the call takes its own job's time, not the unwanted one's 30 s."""
+    ahead.run([("sleep", 0.2)], ahead=[("sleep", 30.0)])
+    started = time.monotonic()
+    (job, _, _), = ahead.run([("sleep", 0.0)])
+    assert job == ("sleep", 0.0) and time.monotonic() - started < 5.0
+    assert ahead.unused == 1 and not ahead._live
+
+
+def test_a_job_s_exception_reaches_the_caller_and_nothing_is_left_running(ahead):
+    with pytest.raises(ValueError, match="job 7 failed"):
+        ahead.run([("fail", 7), ("sleep", 0.1)], ahead=[("sleep", 30.0)])
+    assert not ahead._live
