@@ -28,7 +28,10 @@ def key(job):
 
 
 @pytest.fixture
-def ahead():
+def ahead(monkeypatch):
+    """Two processes on a machine whose other processes leave a core free
+    (whatever else the test run does)."""
+    monkeypatch.setattr("design.solvers.optimize.ahead.others_running", lambda: 0)
     runner = Ahead(stamped, key, processes=2)
     yield runner
     runner.close()
@@ -67,3 +70,15 @@ def test_a_job_s_exception_reaches_the_caller_and_nothing_is_left_running(ahead)
     with pytest.raises(ValueError, match="job 7 failed"):
         ahead.run([("fail", 7), ("sleep", 0.1)], ahead=[("sleep", 30.0)])
     assert not ahead._live
+
+
+def test_nothing_runs_ahead_while_other_processes_keep_every_core_busy(ahead, monkeypatch):
+    """Where the machine's cores are all taken (another case's processes), a
+    run ahead would only slow the runs asked for: none is started, and the
+    next call runs its job then."""
+    monkeypatch.setattr("design.solvers.optimize.ahead.others_running", lambda: ahead.cores)
+    later = ("sleep", 0.0)
+    ahead.run([("sleep", 0.3)], ahead=[later])
+    asked = time.monotonic()
+    (_, _, began), = ahead.run([later])
+    assert began >= asked and ahead.used == 0

@@ -10,6 +10,10 @@ is the computation it would be when asked for (the same job: design, bird
 and rival), so what the caller gets, and decides, does not depend on
 whether it ran ahead; one no longer wanted is killed.
 
+A job runs ahead only on a core that is free: where other processes keep
+every core busy (two cases of a study, each with its processes), a run
+ahead would take time from the runs asked for.
+
 A forked process computes exactly what this one would: it starts from this
 process's state at the fork, with its built functions.
 """
@@ -17,8 +21,10 @@ process's state at the fork, with its built functions.
 from __future__ import annotations
 
 import multiprocessing
+import os
 from collections.abc import Callable, Hashable, Sequence
 from multiprocessing.connection import wait
+from pathlib import Path
 
 
 class _Forked:
@@ -36,19 +42,26 @@ class _Forked:
         return self._receive
 
     def done(self) -> bool:
-        return self._outcome is not None or self._receive.poll()
+        """Whether the call has answered; its process then has ended, so that
+        it no longer counts among the machine's running processes."""
+        if self._outcome is None and self._receive.poll():
+            self._collect()
+        return self._outcome is not None
+
+    def _collect(self) -> None:
+        try:
+            self._outcome = self._receive.recv()
+        except EOFError:
+            self._outcome = ("error", RuntimeError(
+                f"a simulation's process ended without an answer "
+                f"(exit code {self._process.exitcode})"))
+        self._process.join()
+        self._receive.close()
 
     def value(self):
         """The call's value (waiting for it), or its exception raised here."""
         if self._outcome is None:
-            try:
-                self._outcome = self._receive.recv()
-            except EOFError:
-                self._outcome = ("error", RuntimeError(
-                    f"a simulation's process ended without an answer "
-                    f"(exit code {self._process.exitcode})"))
-            self._process.join()
-            self._receive.close()
+            self._collect()
         kind, value = self._outcome
         if kind == "error":
             raise value
@@ -75,12 +88,23 @@ def _call(fn: Callable, job, send) -> None:
     send.close()
 
 
+def others_running() -> int:
+    """Processes running or ready to run on this machine now, besides this
+    one: Linux's /proc/loadavg; elsewhere the load average of the last
+    minute, rounded."""
+    try:
+        return int(Path("/proc/loadavg").read_text().split()[3].split("/")[0]) - 1
+    except (OSError, ValueError, IndexError):
+        return round(os.getloadavg()[0])
+
+
 class Ahead:
     """Calls of ``fn`` on ``processes`` cores, each in a forked process;
     ``key(job)`` names what a job computes (equal keys, equal values)."""
 
     def __init__(self, fn: Callable, key: Callable[[object], Hashable], processes: int):
         self.fn, self.key, self.processes = fn, key, processes
+        self.cores = os.cpu_count() or 1
         self._context = multiprocessing.get_context("fork")
         #: jobs run ahead, by key, running or done, not yet asked for
         self._ahead: dict[Hashable, _Forked] = {}
@@ -89,9 +113,10 @@ class Ahead:
         self._live: set[_Forked] = set()
 
     def run(self, jobs: Sequence, ahead: Sequence = ()) -> list:
-        """``[fn(job) for job in jobs]``; while they run, a free core starts
-        the jobs of ``ahead`` in turn (a later call's, probably). Jobs run
-        ahead that are neither in ``jobs`` nor in ``ahead`` are killed."""
+        """``[fn(job) for job in jobs]``; while they run, a free core (of
+        this call's and of the machine's) starts the jobs of ``ahead`` in
+        turn (a later call's, probably). Jobs run ahead that are neither in
+        ``jobs`` nor in ``ahead`` are killed."""
         try:
             return self._run(jobs, ahead)
         except BaseException:
@@ -114,20 +139,21 @@ class Ahead:
         while True:
             running = [f for f in [*forked, *self._ahead.values()]
                        if f is not None and not f.done()]
-            while len(running) < self.processes and (todo or later):
-                if todo:
-                    i = todo.pop(0)
-                    forked[i] = self._fork(jobs[i])
-                    running.append(forked[i])
-                else:
-                    job = later.pop(0)
-                    self._ahead[self.key(job)] = self._fork(job)
-                    running.append(self._ahead[self.key(job)])
+            while len(running) < self.processes and todo:
+                i = todo.pop(0)
+                forked[i] = self._fork(jobs[i])
+                running.append(forked[i])
+            while len(running) < self.processes and later and others_running() < self.cores:
+                job = later.pop(0)
+                self._ahead[self.key(job)] = self._fork(job)
+                running.append(self._ahead[self.key(job)])
             if not todo and all(f.done() for f in forked):
                 values = [f.value() for f in forked]
                 self._live -= set(forked)
                 return values
-            wait([f.connection for f in running])
+            waiting = [f.connection for f in running if not f.done()]
+            if waiting:
+                wait(waiting)
 
     def _fork(self, job) -> _Forked:
         forked = _Forked(self._context, self.fn, job)
