@@ -14,8 +14,7 @@ import multiprocessing
 import os
 from collections.abc import Callable, Sequence
 
-#: the function :func:`forked_map`'s processes call (set before they fork)
-_JOB: Callable | None = None
+from design.solvers.optimize.ahead import Ahead
 
 
 def processes(workers: int | None, tasks: int | None = None) -> int:
@@ -29,21 +28,15 @@ def processes(workers: int | None, tasks: int | None = None) -> int:
     return wanted if wanted > 1 and usable else 1
 
 
-def _call(item):
-    return _JOB(item)
-
-
 def forked_map(fn: Callable, items: Sequence, workers: int | None = None) -> list:
-    """``[fn(item) for item in items]``, the items handed out in order to
-    :func:`processes` forked processes (``fn`` need not pickle, its results
-    must)."""
-    global _JOB
+    """``[fn(item) for item in items]``, the items handed out in order, each to
+    a forked process of its own, :func:`processes` at a time (``fn`` need not
+    pickle, its results must)."""
     count = processes(workers, len(items))
     if count == 1:
         return [fn(item) for item in items]
-    _JOB = fn
+    runner = Ahead(fn, id, count)
     try:
-        with multiprocessing.get_context("fork").Pool(count) as pool:
-            return pool.map(_call, items, chunksize=1)
+        return runner.run(items)
     finally:
-        _JOB = None
+        runner.close()
