@@ -9,6 +9,7 @@ import time
 import pytest
 
 from design.solvers.optimize.ahead import Ahead
+from design.solvers.optimize.forked import forked_map
 
 
 def stamped(job):
@@ -82,3 +83,15 @@ def test_nothing_runs_ahead_while_other_processes_keep_every_core_busy(ahead, mo
     asked = time.monotonic()
     (_, _, began), = ahead.run([later])
     assert began >= asked and ahead.used == 0
+
+
+def test_forked_map_returns_in_order_what_this_process_would():
+    """A design's birds simulated in forked processes (forked_map): each
+    item's value in the items' order, from processes other than this one; on
+    one worker, here."""
+    items = [("sleep", 0.05 * (3 - n)) for n in range(3)]
+    there = forked_map(stamped, items, workers=2)
+    here = forked_map(stamped, items, workers=1)
+    assert [v[0] for v in there] == [v[0] for v in here] == items
+    assert os.getpid() not in {v[1] for v in there}
+    assert {v[1] for v in here} == {os.getpid()}
