@@ -361,17 +361,11 @@ def per_bird(population: Population, value: Scored, what: str) -> list:
     return [simulated.get(id(m)) for m in population.members]
 
 
-#: the population, loop settings and integrator of a :class:`Pairs` pool's
-#: forked processes (set before they fork; the parent's only otherwise)
-_SCORING: tuple | None = None
-
-
-def _simulate_slim(job: tuple[np.ndarray, int, Cutoff | None], scoring: tuple | None = None
-                   ) -> Evaluated:
+def _simulate_slim(job: tuple[np.ndarray, int, Cutoff | None], scoring: tuple) -> Evaluated:
     """Bird ``b``'s simulation of the scaled design ``d``, ended early against
     ``cutoff`` (``job``), slim, by ``scoring``'s population, settings and
-    integrator (default: the pool's)."""
-    population, settings, integrator = scoring or _SCORING
+    integrator."""
+    population, settings, integrator = scoring
     d, b, cutoff = job
     return slim(simulate(population.members[b].space, d, settings, integrator, cutoff))
 
@@ -424,19 +418,18 @@ class Pairs:
         self.children_cpu_time = 0.0
 
     def __enter__(self) -> Pairs:
-        global _SCORING
         if self.processes > 1:
-            _SCORING = self.job
             self._children_before = _children_cpu()
-            self.pool = Ahead(_simulate_slim, _job_key, self.processes)
+            # the forked processes inherit the function: nothing is pickled
+            self.pool = Ahead(lambda job: _simulate_slim(job, self.job), _job_key,
+                              self.processes)
         return self
 
     def __exit__(self, *exc) -> None:
-        global _SCORING
         if self.pool is not None:
             self.pool.close()
             self.ran_ahead = {"used": self.pool.used, "unused": self.pool.unused}
-            self.pool, _SCORING = None, None
+            self.pool = None
             self.children_cpu_time = _children_cpu() - self._children_before
 
     def _simulate(self, jobs: list[tuple[np.ndarray, int, Cutoff | None]], ahead=()
