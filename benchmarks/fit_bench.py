@@ -23,7 +23,7 @@ path of weights.
 
 Prints tables and writes benchmarks/results/fit_bench.json.
 
-    python -m benchmarks.fit_bench              # 72 fits: ~10 minutes on 2 cores
+    python -m benchmarks.fit_bench              # 111 fits: about 8 minutes
     python -m benchmarks.fit_bench --markers 8  # and 24 fits of 8 markers' x + y readings
     python -m benchmarks.fit_bench --starts
 """
@@ -50,8 +50,8 @@ from design.run.finger_fit import DETERMINED_BAND
 from design.run.fit import run
 from design.solvers.beam.collocation import Collocation
 from tests.fit_benches import (FAMILY, FIFTH_BATCH, FOURTH_BATCH, MARKERS, NOISE, READINGS,
-                               SECOND_BATCH, STEPPED, THIRD_BATCH, TUNING, readings, score,
-                               write_problem)
+                               SECOND_BATCH, SIXTH_BATCH, STEPPED, THIRD_BATCH, TUNING, readings,
+                               score, write_problem)
 
 RESULTS = Path(__file__).parent / "results" / "fit_bench.json"
 
@@ -90,11 +90,11 @@ def fit_row(folder: Path, name: str, which: str, markers: int = MARKERS) -> dict
 
 
 def batch(name: str) -> str:
-    """The bench's set: development, or the first to fifth held-out batch."""
+    """The bench's set: development, or the first to sixth held-out batch."""
     if name in TUNING:
         return "development"
     later = {"second": SECOND_BATCH, "third": THIRD_BATCH, "fourth": FOURTH_BATCH,
-             "fifth": FIFTH_BATCH}
+             "fifth": FIFTH_BATCH, "sixth": SIXTH_BATCH}
     return next((f"held out, {n} batch" for n, names in later.items() if name in names),
                 "held out")
 
@@ -183,7 +183,7 @@ def main() -> None:
     summary = {}
     sets = [(label, MARKERS) for label in ("development", "held out", "held out, second batch",
                                            "held out, third batch", "held out, fourth batch",
-                                           "held out, fifth batch")] + \
+                                           "held out, fifth batch", "held out, sixth batch")] + \
         [(f"{n} markers, x + y", n) for n in args.markers]
     for label, markers in sets:
         subset = [r for r in rows if r["markers"] == markers

@@ -6,8 +6,10 @@ exponential profile (models/fingers), and a step change; plus Gaussian
 noise of 0.1 mm with a fixed seed. A bench: weights at four points, a
 marker every 10 mm.
 
-Tolerances, where the data determine EI (the fit's own 95 % band within
-±25 %, and no further than the last loaded or measured point):
+Tolerances, on the knots where the fit's own 95 % band is within ±25 % and
+no further than the last loaded or measured point (``JUDGED_BAND``: wider
+than the ±10 % within which ``design fit`` calls EI determined, so that the
+estimator is judged over most of the finger):
 
 * uniform: 3 %. The band there is ±2-10 %: the noise's share.
 * the thesis's profile: 15 %. EI falls 3x within 30 mm of the clamp (rates
@@ -18,12 +20,12 @@ Tolerances, where the data determine EI (the fit's own 95 % band within
   more than 15 mm (two knots, one and a half marker spacings) before it.
   The roughness penalty smooths the step over about 30 mm, overshooting by
   up to 50 % next to it; on the soft side the bench's two loads leave the
-  band wider than ±25 % (not determined), and there the test asks only
+  band wider than ±25 % (not judged), and there the test asks only
   that the truth lie inside the band.
 
-Also: the true EI lies inside the 95 % band at most of the determined
-knots, held-out loads are predicted within the noise, and the weight GCV
-picks predicts held-out loads better than fixed extreme weights.
+Also: the true EI lies inside the 95 % band at most of the judged knots,
+held-out loads are predicted within the noise, and the weight GCV picks
+predicts held-out loads better than fixed extreme weights.
 """
 
 from __future__ import annotations
@@ -46,12 +48,13 @@ from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import Stiffness, UniformEI
 from design.reproduce.grasp import load_model
-from design.run.finger_fit import DETERMINED_BAND
 
 LENGTH = 0.203
 NOISE = 1e-4                   # m, the bench's stated and simulated noise
 MARKERS = np.round(np.arange(0.01, 0.2001, 0.01), 4)
 KNOTS = np.linspace(0.0, LENGTH, 31)
+#: a knot is judged where the fit's band is within ± this (see the module docstring)
+JUDGED_BAND = 0.25
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,14 +116,14 @@ def convex_fit(data: FingerData, monotone=None):
     return fit_compliance(K, data.values[used], data.sigmas[used], KNOTS, used, monotone)
 
 
-def determined(fit, data: FingerData) -> np.ndarray:
-    return (KNOTS <= data.reach + 1e-12) & (fit.band <= DETERMINED_BAND)
+def judged(fit, data: FingerData) -> np.ndarray:
+    return (KNOTS <= data.reach + 1e-12) & (fit.band <= JUDGED_BAND)
 
 
 def recovery(fit, data, profile: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Relative EI error, the band's relative half-width and the determined mask."""
+    """Relative EI error, the band's relative half-width and the judged mask."""
     true = PROFILES[profile].ei(KNOTS)
-    return (1 / fit.c - true) / true, fit.band, determined(fit, data)
+    return (1 / fit.c - true) / true, fit.band, judged(fit, data)
 
 
 @pytest.mark.parametrize("profile, monotone, tolerance, away", [
@@ -235,7 +238,7 @@ def test_the_elastica_refinement_recovers_ei_from_large_deflections():
     """Two loads bending the uniform finger to 0.3 rad: the small-deflection
     fit misses by many noise levels; refined on the collocated elastica
     (Ipopt) from the uniform EI that fits the readings on the elastica, it
-    recovers EI within 2 % where determined (the noise's share on a uniform
+    recovers EI within 2 % where judged (the noise's share on a uniform
     finger) and fits to the noise (σ̂ within 0.7-1.3: 60 readings)."""
     data, _ = bench("uniform", scale=8.0, points=((0.2, (0.15, 0.3)),))
     data = data.subset(lambda o: round(o.s * 100) % 2 == 0)          # markers every 20 mm
@@ -248,7 +251,7 @@ def test_the_elastica_refinement_recovers_ei_from_large_deflections():
                  start.solutions)
     assert ref.success
     fit = ref.fit
-    det = (knots <= data.reach) & (fit.band <= DETERMINED_BAND)
+    det = (knots <= data.reach) & (fit.band <= JUDGED_BAND)
     assert det.sum() >= 6 and np.max(np.abs(1 / fit.c[det] / 0.08 - 1)) <= 0.02
     assert 0.7 < fit.selection.noise_scale < 1.3
 
@@ -258,7 +261,7 @@ def test_x_readings_alone_recover_ei_from_large_deflections():
     position along it, at 20 markers: no small-deflection fit can use these
     (x = s to first order), so the refinement starts from the uniform
     elastica fit. x carries the bending at second order only, so its band is
-    wider than y's (up to ±25 % where determined): EI within 5 % there, and
+    wider than y's (up to ±25 % where judged): EI within 5 % there, and
     the residuals at the noise (σ̂ within 0.7-1.3: 60 readings)."""
     data, _ = bench("uniform", scale=8.0, points=((0.1, (0.6,)), (0.2, (0.15, 0.3))))
     xs = FingerData(data.loads, tuple(Observation(o.case, o.s, "x", v, o.sigma, o.line)
@@ -270,7 +273,7 @@ def test_x_readings_alone_recover_ei_from_large_deflections():
                  start.solutions)
     assert ref.success
     fit = ref.fit
-    det = (knots <= xs.reach) & (fit.band <= DETERMINED_BAND)
+    det = (knots <= xs.reach) & (fit.band <= JUDGED_BAND)
     assert det.sum() >= 6 and np.max(np.abs(1 / fit.c[det] / 0.08 - 1)) <= 0.05
     assert 0.7 < fit.selection.noise_scale < 1.3
 
