@@ -68,8 +68,9 @@ def stage_inputs(setup, record, i: int) -> dict:
 @pytest.fixture(scope="module")
 def finger_4a(placed):
     """Finger 4a's NLP function, interpreted (the formula, not the compiler:
-    compiling it takes about 60 s on an empty cache), with its inputs and
-    the simulator's state at the last record."""
+    compiling it takes 30-60 s on an empty cache) and built here for the
+    record's contact mode (a function is built when first asked for), with
+    its inputs and the simulator's state at the last record."""
     from design.solvers.optimize.finger_load import FingerLoad
     setup, run = placed
     i = [gf.name for gf in setup.grasper.fingers].index("4a")
@@ -78,6 +79,7 @@ def finger_4a(placed):
         patch.setenv("DESIGN_COMPILE", "0")
         load = FingerLoad(setup.grasper.fingers[i], setup.grasper, setup.bird,
                           setup.finger_friction, SPATIAL_NODES, 4, "spatial")
+        load.function(record.fingers[i].solution.extras["mode"])
     return load, stage_inputs(setup, record, i), record.fingers[i], record
 
 
