@@ -23,14 +23,13 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import time
 from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_bvp
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.io.fingers import read_finger
 from design.physics.beam import Finger, PointLoad
 from design.physics.stiffness import UniformEI
@@ -178,9 +177,7 @@ def run(quick: bool) -> dict:
 
     default_colloc = next(r for r in sweep if r["method"] == "collocation" and r["default"])
     return {
-        "machine": {"python": platform.python_version(), "processor": platform.processor(),
-                    "cores": os.cpu_count(), "load_average_at_start": load_average,
-                    "load_average_at_end": os.getloadavg()},
+        "machine": machine(load_average, at_end=True),
         "quick": quick, "sweep_loads": n,
         "timing": "warm against warm: the first call of every method and setting (CasADi "
                   "functions built) is reported apart as first_call_s / "

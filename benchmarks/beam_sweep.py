@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import platform
 import time
 from pathlib import Path
 
@@ -40,7 +39,7 @@ import numpy as np
 
 import design
 from benchmarks.beam import bvp_sweep
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.io.fingers import read_finger
 from design.physics.beam import PointLoad
 from design.reproduce.grasp import load_model
@@ -129,9 +128,7 @@ def run_case(name: str, repeat: int) -> dict:
 def run(repeat: int) -> dict:
     start = os.getloadavg()
     cases = {name: run_case(name, repeat) for name in CASES}
-    return {"machine": {"cores": os.cpu_count(), "python": platform.python_version(),
-                        "casadi": ca.__version__, "load_average_at_start": start,
-                        "load_average_at_end": os.getloadavg()},
+    return {"machine": {**machine(start, at_end=True), "casadi": ca.__version__},
             "repeat": repeat,
             "timing": "warm against warm: simulate's first call (compiled library built or "
                       "loaded) apart; then simulate and solve_bvp sweeps alternate; per solve = "

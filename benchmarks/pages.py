@@ -46,12 +46,14 @@ def when(path: Path, data: dict) -> str:
 
 
 def machine(data: dict) -> str:
-    """Cores, Python and load average of the run, as far as it recorded them."""
+    """Cores, processor, Python and load average of the run, as far as it
+    recorded them."""
     m = data.get("machine", {})
     cores = m.get("cores") or m.get("cpus") or data.get("cores")
     load = m.get("load_average_at_start") or data.get("loadavg", {}).get("start")
     end = m.get("load_average_at_end") or data.get("loadavg", {}).get("end")
-    parts = [f"{cores} cores" if cores else "", f"Python {m['python']}" if "python" in m else "",
+    parts = [f"{cores} cores" if cores else "", m.get("cpu", ""),
+             f"Python {m['python']}" if "python" in m else "",
              f"load average {load[0]:.1f}" + (f" to {end[0]:.1f}" if end else "")
              if load else ""]
     return ", ".join(p for p in parts if p) or "machine not recorded"

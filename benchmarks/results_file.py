@@ -13,10 +13,23 @@ from pathlib import Path
 from design.io.results import jsonable
 
 
+def cpu_model() -> str:
+    """The processor's model name (Linux's /proc/cpuinfo; else what the
+    platform says): machines of the same core count differ by 2-3x in the
+    benchmarks' wall times."""
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
 def machine(load_at_start: tuple[float, ...], at_end: bool = False) -> dict:
-    """The ``machine`` entry of a result: Python, cores, the load averages at
-    the start (given) and, with ``at_end``, now."""
-    out = {"python": platform.python_version(), "cores": os.cpu_count(),
+    """The ``machine`` entry of a result: Python, cores, the processor, the
+    load averages at the start (given) and, with ``at_end``, now."""
+    out = {"python": platform.python_version(), "cores": os.cpu_count(), "cpu": cpu_model(),
            "load_average_at_start": load_at_start}
     return {**out, "load_average_at_end": os.getloadavg()} if at_end else out
 

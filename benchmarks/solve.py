@@ -83,7 +83,6 @@ import argparse
 import json
 import multiprocessing
 import os
-import platform
 import resource
 import time
 from concurrent.futures import ProcessPoolExecutor
@@ -94,7 +93,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.api import check, solve
 from design.run.solve import design_space
 from design.solvers.optimize.profile import profile_text
@@ -405,8 +404,7 @@ def sizes() -> dict:
     end = os.getloadavg()
     print(f"\nsizes: {wall:.0f} s wall; load average {', '.join(f'{x:.2f}' for x in load)} at "
           f"the start, {', '.join(f'{x:.2f}' for x in end)} at the end ({os.cpu_count()} cores)")
-    return {"machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                        "load_average_at_start": load, "load_average_at_end": end},
+    return {"machine": machine(load, at_end=True),
             "problem": "problems/hold_time.yaml", "trust_region": RADIUS,
             "wall_time_s": wall,
             "comparison": "warm against warm (jacobian_over_fd_gradient_warm) and cold against "

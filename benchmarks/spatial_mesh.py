@@ -20,11 +20,10 @@ minutes on 2 cores).
 from __future__ import annotations
 
 import os
-import platform
 import time
 from pathlib import Path
 
-from benchmarks.results_file import write_results
+from benchmarks.results_file import machine, write_results
 from design.reproduce.grasp import football_setup, mean_bird_setup
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import simulate_grasp
@@ -75,8 +74,7 @@ def main() -> None:
                   f"{r['peak_relative_error']:+9.1e} {1e3 * r['centre_rise_m']:8.2f} "
                   f"{r['cpu_s']:6.1f} {r['cpu_over_default']:8.2f}x{mark}", flush=True)
     write_results(RESULTS, {
-        "machine": {"cpus": os.cpu_count(), "python": platform.python_version(),
-                    "load_average_at_start": load, "load_average_at_end": os.getloadavg()},
+        "machine": machine(load, at_end=True),
         "reference_intervals": REFERENCE, "default_intervals": DEFAULT, "degree": 4,
         "scenes": scenes})
 
