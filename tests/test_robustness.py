@@ -59,5 +59,8 @@ def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_
     assert beats[:5] == [True, False, False, False, False] and all(beats[5:])
     assert t["share_beaten"] == pytest.approx((n - 4) / n)
     assert t["broken_by"] == [name for name, _ in CASES[1:5]]
+    assert [r["why_not"] for r in t["cases"][:5]] == [
+        "", "holds no longer", "over the cap", "jams", "a run ended early"]
     assert t["cases"][4]["optimum_jam"].startswith("the run ended early")
     assert robustness_text(t).startswith(f"the optimum beats the baseline in {n - 4} of {n}")
+    assert f"{CASES[2][0]} (over the cap)" in robustness_text(t)

@@ -245,7 +245,8 @@ def robustness_section(page: Page, robust: dict) -> None:
                  "optimum peak (N)": r["optimum_max_finger_force_N"],
                  "baseline jam": r["baseline_jam"] or "none",
                  "optimum jam": r["optimum_jam"] or "none",
-                 "optimum beats baseline": r["optimum_beats_baseline"]}
+                 "optimum beats baseline": r["optimum_beats_baseline"],
+                 "why not": r["why_not"]}
                 for r in robust["cases"]], "Baseline and optimum in perturbed scenes",
                "robustness-table")
 
