@@ -106,6 +106,11 @@ def main_job(path: Path, data: dict) -> list[str]:
                ("search simulations", job["simulations"])] if job.get("method") == "pattern"
               else [("outer iterations", job["outer_iterations"]),
                     ("Ipopt iterations", job["ipopt_iterations"])]),
+            *([("optimum beats the baseline in perturbed scenes",
+                f"{job['robustness']['share_beaten']:.0%}"),
+               ("scenes where it does not (why)", "; ".join(
+                   f"{case} ({why})" for case, why in job["robustness"]["not_beaten"].items())
+                or "none")] if job.get("robustness") else []),
             ("wall time through the API (s)", job["api_wall_time_s"]),
             ("CPU time of the run's own process (s)", profile["cpu_time_s"]),
             *([("CPU time of the search's two processes (s)",

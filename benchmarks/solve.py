@@ -371,6 +371,10 @@ def main_job() -> dict:
                 (result["solver"]["search"] or {}).get("processes_cpu_time_s"),
             "ipopt_iterations": result["solver"]["iterations"],
             "outer_iterations": result["solver"]["outer_iterations"],
+            "robustness": None if not result.get("robustness") else {
+                "share_beaten": result["robustness"]["share_beaten"],
+                "not_beaten": {r["case"]: r["why_not"] for r in result["robustness"]["cases"]
+                               if not r["optimum_beats_baseline"]}},
             "api_wall_time_s": wall, "load_average_at_start": load,
             "load_average_at_end": os.getloadavg(), "profile": result["profile"]}
 
