@@ -235,10 +235,9 @@ def robustness_section(page: Page, robust: dict) -> None:
     page.section("Robustness: what the problem does not know", "robustness")
     page.text(f"{robustness_text(robust)[0].upper()}{robustness_text(robust)[1:]} (target: "
               f"{robust['target_share']:.0%}). Each scene changes one thing the design problem "
-              f"fixes and runs one finger-set period past the design scene's end (a release "
-              f"the change delays is not taken for a jam); the optimum beats the baseline "
-              f"where it holds longer, stays under the {robust['cap_N']:.2f} N cap and does "
-              f"not jam. Both designs run on the optimiser's simulator.")
+              f"fixes; the optimum beats the baseline where it holds longer, stays under the "
+              f"{robust['cap_N']:.2f} N cap and does not jam. Both designs run on the "
+              f"optimiser's simulator.")
     page.table([{"scene": r["case"],
                  "baseline hold (s)": r["baseline_hold_time_s"],
                  "optimum hold (s)": r["optimum_hold_time_s"],

@@ -9,15 +9,6 @@ for finger 5). The baseline and the optimum are simulated again in every
 such case (:data:`CASES`), each changed alone, and the optimum *beats* the
 baseline there when it holds longer, stays under the cap and does not jam.
 
-Every case runs one finger-set period (2 π / (sets ω): 1 s for Table 5-1's
-three sets at 20 rpm) past the design scene's end. The design's own "no
-jam" asks for the bird to be back on the belt when its scene ends; a
-perturbation that delays the release (the drums turned back, no finger
-friction) can hold the bird a few tens of ms past that, which at the
-scene's own end would be taken for a jam. A bird still held a set period
-later, when the next set stands where the holding one stood, is jammed at
-one bird per set.
-
 The runs go to the design run's background process (design/solvers/optimize/
 model_check.py's :class:`ModelCheck`), the baseline's at the start of the
 run, the optimum's once it is picked.
@@ -32,7 +23,6 @@ import numpy as np
 
 from design.io.grasp_scene import read_bird
 from design.physics.belt import Belt
-from design.reproduce.grasp import load_model, set_period
 from design.solvers.grasp.simulation import GraspSetup
 from design.solvers.optimize.trust_region import CAP_TOLERANCE
 
@@ -57,6 +47,7 @@ def _phase(degrees: float) -> Callable[[GraspSetup], GraspSetup]:
 
 def _bird(file: str) -> Callable[[GraspSetup], GraspSetup]:
     def other(s: GraspSetup) -> GraspSetup:
+        from design.reproduce.grasp import load_model
         return replace(s, bird=load_model(read_bird, "birds", file))
     return other
 
@@ -87,10 +78,8 @@ CASES: tuple[tuple[str, Callable[[GraspSetup], GraspSetup]], ...] = (
 
 
 def scenes(setup: GraspSetup) -> list[GraspSetup]:
-    """The design's scene changed as each case says, in :data:`CASES` order,
-    each run one finger-set period longer (see the module docstring)."""
-    longer = replace(setup, duration=setup.duration + set_period(setup.grasper, setup.drum_speed))
-    return [change(longer) for _, change in CASES]
+    """The design's scene changed as each case says, in :data:`CASES` order."""
+    return [change(setup) for _, change in CASES]
 
 
 def table(baseline: list[dict], optimum: list[dict], cap: float) -> dict:
