@@ -126,7 +126,7 @@ def main_job(path: Path, data: dict) -> list[str]:
                                          "calls": lambda r: r["calls"]})]
     # --profile-only keeps the NLP sizes' date and machine: the job has its own
     measured = {**data, "measured_at": job.get("measured_at", data.get("measured_at")),
-                "machine": {**data.get("machine", {}),
+                "machine": {**data.get("machine", {}), "cpu": job.get("cpu", ""),
                             "load_average_at_start": job["load_average_at_start"],
                             "load_average_at_end": job["load_average_at_end"]}}
     return section("The main job", "solve --profile-only", path, measured, lines)

@@ -93,7 +93,7 @@ from pathlib import Path
 import casadi as ca
 import numpy as np
 
-from benchmarks.results_file import machine, write_results
+from benchmarks.results_file import cpu_model, machine, write_results
 from design.api import check, solve
 from design.run.solve import design_space
 from design.solvers.optimize.profile import profile_text
@@ -375,7 +375,7 @@ def main_job() -> dict:
                 "share_beaten": result["robustness"]["share_beaten"],
                 "not_beaten": {r["case"]: r["why_not"] for r in result["robustness"]["cases"]
                                if not r["optimum_beats_baseline"]}},
-            "api_wall_time_s": wall, "load_average_at_start": load,
+            "api_wall_time_s": wall, "cpu": cpu_model(), "load_average_at_start": load,
             "load_average_at_end": os.getloadavg(), "profile": result["profile"]}
 
 
