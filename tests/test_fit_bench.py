@@ -18,7 +18,7 @@ held to over the judged span (where the fit says EI is determined, less
 
 "Determined" is a band within ±10 %: the accuracy asked of the fit there.
 With a wider band the fit can be off by more than 10 % while its band holds
-the truth: with ±25 % held-out fits were, where ln EI bends over a few
+the truth: at ±25 % some held-out fits were, where ln EI bends over a few
 centimetres (a taper levelling off, a fall near the tip, a thickness
 falling as (s/L)^0.7 to (s/L)^1.8). The tapers meet every target with x
 and y readings, or y alone; x alone determines EI over half the finger on
