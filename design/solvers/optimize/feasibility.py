@@ -19,8 +19,9 @@ bird at all keeps it within its limits and holds nobody.
   lifting it. Each start ends at the first design that reaches the goal, or
   when its budget of simulations is spent; the starts are tried in turn,
   and the first that reaches the goal ends the screen.
-* Each simulation has a budget of contact work (:data:`NEWTON_SOLVES`):
-  one past it stops and counts as a failed run.
+* Each simulation has the loop's budget of contact work
+  (:data:`~design.solvers.optimize.trust_region.LOOP_NEWTON_SOLVES`): one
+  past it stops and counts as a failed run.
 * A design that reaches it starts the population's search.
 * If no start reaches one, the population's search is not run: the answer
   is each start's best, the best of them simulated for every bird. It is
@@ -31,27 +32,20 @@ bird at all keeps it within its limits and holds nobody.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from design.solvers.optimize.pattern_search import HOLD_BAND, Pairs, allowed_by, compass
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.transcription import Rules
-from design.solvers.optimize.trust_region import (FORCE_BAND, LoopSettings, Outcome, Scored,
-                                                   alone, score)
+from design.solvers.optimize.trust_region import (FORCE_BAND, LOOP_NEWTON_SOLVES, LoopSettings,
+                                                   Outcome, Scored, alone, score)
 
-#: each screen simulation's budget of belt-continuation rootfinder calls per
-#: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
-#: at the baseline call it 90-500 times a second; a Sobol start can land on
-#: designs whose contact it cannot follow cheaply, and one such simulation
-#: ran for over ten minutes where seconds are usual. A run stopped by it is
-#: a failed run, the worst a design can be.
-NEWTON_SOLVES = 2000
-#: the same budget for the 4x finer verification of a screen's answer (four
-#: times the steps): an answer the screen could not improve fails its run
-#: anyway, and its verification must end
-VERIFY_NEWTON_SOLVES = 4 * NEWTON_SOLVES
+#: the loop's budget of contact work for the 4x finer verification of a
+#: screen's answer (four times the steps): an answer the screen could not
+#: improve fails its run anyway, and its verification must end
+VERIFY_NEWTON_SOLVES = 4 * LOOP_NEWTON_SOLVES
 #: ``solver.search.method`` of a run the screen answered
 METHOD = "feasibility screen"
 #: the screen's starts and each one's budget of simulations, by default:
@@ -108,7 +102,7 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
     limits that holds it longer than ``beyond`` (s; None: any hold), or
     after ``budget`` simulations (the start's included)."""
     start = np.asarray(start, float)
-    pool = Pairs(bird, settings, budgeted(settings.simulator), workers)
+    pool = Pairs(bird, settings, settings.simulator, workers)
 
     def beats(a: Scored, b: Scored) -> bool:
         return nearer(distance(*a.shortfall(cap), a.hold, beyond),
@@ -169,8 +163,7 @@ def unreached(population: Population, caps, settings: LoopSettings, rows: list[d
     screen's every start."""
     caps = np.broadcast_to(np.asarray(caps, float), (len(population.members),)).copy()
     k = best_row(rows)
-    best = score(population, np.array(rows[k]["d"]), settings, budgeted(settings.simulator),
-                 workers=None)
+    best = score(population, np.array(rows[k]["d"]), settings, workers=None)
     out = Outcome(best, None, caps)
     source = "the feasibility screen's simulation (as the pattern search simulates)"
     out.claims = [(m.hold, source) for m in best.members]
@@ -179,11 +172,6 @@ def unreached(population: Population, caps, settings: LoopSettings, rows: list[d
                   "simulations": sum(r["simulations"] for r in rows) + len(population.members),
                   "rtol": settings.simulator.rtol, "caps_N": caps.tolist()}
     return out
-
-
-def budgeted(simulator):
-    """The screen's simulator: the search's, with :data:`NEWTON_SOLVES`."""
-    return replace(simulator, max_newton_solves=NEWTON_SOLVES)
 
 
 def answered(search: dict | None) -> bool:

@@ -4,8 +4,8 @@ solver options under the solve layer's policy, whoever built the problem
 
 >>> from design.io.grasp_scene import GraspSettings
 >>> s = loop_settings({"time_step": 0.01}, GraspSettings(contact_nodes=3))
->>> s.nlp.time_step, s.nlp.beam_intervals, s.simulator.max_step
-(0.01, 3, 0.01)
+>>> s.nlp.time_step, s.nlp.beam_intervals, s.simulator.max_step, s.simulator.max_newton_solves
+(0.01, 3, 0.01, 2000)
 """
 
 from __future__ import annotations
@@ -35,7 +35,8 @@ def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
       :data:`~design.solvers.optimize.trust_region.LOOP_SIMULATOR`'s
       tolerances (its accept/reject decisions compare holds a few ms apart)
       and with steps no longer than the NLP's time grid (whose view of a
-      design must reproduce them; the verification runs at a quarter of it);
+      design must reproduce them; the verification runs at a quarter of it),
+      each run with the loop's budget of contact work;
     * the NLP's finger mesh, and the loop simulations', is ``beam_intervals``
       if stated, else the scene's ``contact_nodes``.
     """
@@ -47,7 +48,8 @@ def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
     given = scene.integrator
     simulator = replace(given, rtol=min(given.rtol, LOOP_SIMULATOR.rtol),
                         atol=min(given.atol, LOOP_SIMULATOR.atol),
-                        max_step=min(given.max_step, nlp.time_step))
+                        max_step=min(given.max_step, nlp.time_step),
+                        max_newton_solves=LOOP_SIMULATOR.max_newton_solves)
     return LoopSettings(nlp, solver.get("outer_iterations", d.outer_iterations),
                         solver.get("trust_region", d.radius), d.min_radius, simulator, mesh,
                         solver.get("cap_margin", d.cap_margin),

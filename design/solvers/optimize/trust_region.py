@@ -66,12 +66,23 @@ VIEW_MAX_ITER, VIEW_STALL = 100, 15
 BACK_OFF = 0.9
 
 
+#: each loop simulation's budget of belt-continuation rootfinder calls per
+#: simulated second (IntegratorSettings.max_newton_solves): Table 5-5's birds
+#: at the baseline call it 90-500 times a second, the main job's designs at
+#: most 400; a finger pressed to where its quasi-static contact ends (a fold,
+#: a touch with no consistent contact) can call it thousands of times in a
+#: few ms of simulated time, and one such simulation ran for over five
+#: minutes where seconds are usual. A run stopped by it is a failed run, the
+#: worst a design can be; the count is the same on every machine, unlike a
+#: wall-time limit.
+LOOP_NEWTON_SOLVES = 2000
 #: the loop's simulator is tighter than a grasp scene's default (rtol 1e-4):
 #: its accept/reject decisions compare holds a few ms apart and its views
 #: must reproduce them within 2 % (docs/design-method.md). Its steps are no
 #: longer than the NLP's time grid (a design problem's own grid:
 #: design/solvers/optimize/policy.py)
-LOOP_SIMULATOR = IntegratorSettings(rtol=1e-6, atol=1e-8, max_step=NLPSettings.time_step)
+LOOP_SIMULATOR = IntegratorSettings(rtol=1e-6, atol=1e-8, max_step=NLPSettings.time_step,
+                                    max_newton_solves=LOOP_NEWTON_SOLVES)
 
 
 @dataclass(frozen=True)
