@@ -11,7 +11,8 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
-from design.solvers.optimize.robustness import CASES, robustness_text, scenes, table
+from design.solvers.optimize.robustness import (CASES, robustness_text, scenes, simulator,
+                                              table)
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -64,3 +65,17 @@ def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_
     assert t["cases"][4]["optimum_jam"].startswith("the run ended early")
     assert robustness_text(t).startswith(f"the optimum beats the baseline in {n - 4} of {n}")
     assert f"{CASES[2][0]} (over the cap)" in robustness_text(t)
+
+
+def test_the_scenes_run_as_design_simulate_runs_them_within_the_loops_budget():
+    """The perturbed scenes run on the scene's own integrator (rtol 1e-4,
+    steps up to 10 ms: what a user re-running a scene gets), not the
+    search's tighter one, and stop as failed runs past the design loop's
+    contact-work budget, as the search's do."""
+    problem = load_scene(ROOT / "problems" / "hold_time.yaml")
+    own = problem.scene.settings.integrator
+    used = simulator(own)
+    assert (used.rtol, used.atol, used.max_step) == (own.rtol, own.atol, own.max_step) \
+        == (1e-4, 1e-6, 1e-2)
+    assert used.max_newton_solves == problem.settings.simulator.max_newton_solves == 2000
+    assert problem.settings.simulator.rtol == 1e-6

@@ -237,7 +237,7 @@ def robustness_section(page: Page, robust: dict) -> None:
               f"{robust['target_share']:.0%}). Each scene changes one thing the design problem "
               f"fixes; the optimum beats the baseline where it holds longer, stays under the "
               f"{robust['cap_N']:.2f} N cap and does not jam. Both designs run on the "
-              f"optimiser's simulator.")
+              f"scene's own simulator, as design simulate runs it.")
     page.table([{"scene": r["case"],
                  "baseline hold (s)": r["baseline_hold_time_s"],
                  "optimum hold (s)": r["optimum_hold_time_s"],

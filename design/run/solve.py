@@ -128,7 +128,8 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     if problem.model_check != "none":
         check.submit(BASELINE, population, d0)
     if problem.robustness:
-        check.submit_setups(ROBUST_BASELINE, robustness.scenes(space.setup(d0)))
+        check.submit_setups(ROBUST_BASELINE, robustness.scenes(space.setup(d0)),
+                            robustness.simulator(problem.scene.settings.integrator))
     say("simulating the baseline at 4x the optimiser's resolution"
         + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
@@ -196,7 +197,7 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
     model_check, robust = None, None
     optimum = entries[0]["status"] in (VERIFIED, FAILED)        # else no optimum to check
     if problem.robustness and optimum:
-        check.submit_setups(ROBUST_OPTIMUM, robustness.scenes(space.setup(fine.d)))
+        submit_robustness(problem, space, check, entries[0]["case"], fine.d)
     if problem.model_check != "none" and optimum:
         check.submit(entries[0]["case"], population, fine.d)
         with profile.phase(MODEL_CHECK):
@@ -204,7 +205,8 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
                                        optimum=entries[0]["case"])
     if problem.robustness and optimum:
         with profile.phase(ROBUSTNESS):
-            robust = robustness.table(check.runs(ROBUST_BASELINE), check.runs(ROBUST_OPTIMUM),
+            robust = robustness.table(check.runs(ROBUST_BASELINE),
+                                      check.runs(robust_optimum(entries[0]["case"])),
                                       float(caps[0][0]))
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], fine,
@@ -235,7 +237,7 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
 #: a case's status when its design loop ended in ERROR
 NO_DESIGN = "no design (optimiser error)"
 #: the labels of the robustness table's background runs
-ROBUST_BASELINE, ROBUST_OPTIMUM = "robustness: baseline", "robustness: optimum"
+ROBUST_BASELINE = "robustness: baseline"
 #: the study's case for a population's single-bird comparison
 SINGLE_BIRD = "single-bird"
 #: the study's case for a population's feasibility screen
@@ -334,6 +336,8 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     certify(population, outcome, settings, problem.rules, progress)
     if check and k == 0 and problem.model_check != "none":
         check.submit(case.key, population, outcome.best.d)
+    if check and k == 0 and problem.robustness and problem.multistart.starts == 1:
+        submit_robustness(problem, space, check, case.key, outcome.best.d)
     say("verifying at 4x finer resolution")
     with outcome.profile.phase(VERIFICATION):
         fine = verify(population, outcome.best.d, settings,
@@ -738,3 +742,15 @@ def _pareto_row(entry: dict) -> dict:
             "optimiser_hold_time_s": entry["objective"]["hold_time_s"],
             "verified_hold_time_s": v["hold_time_s"],
             "verified_max_finger_force_N": v["max_finger_force_N"], "passed": v["passed"]}
+
+
+def robust_optimum(key: str) -> str:
+    """The background runs' label for case ``key``'s design's robustness scenes."""
+    return f"robustness: optimum of {key}"
+
+
+def submit_robustness(problem: DesignProblem, space: DesignSpace, check: ModelCheck, key: str,
+                      d: np.ndarray) -> None:
+    """Queue the robustness scenes of case ``key``'s scaled design ``d`` (once)."""
+    check.submit_setups(robust_optimum(key), robustness.scenes(space.setup(d)),
+                        robustness.simulator(problem.scene.settings.integrator))

@@ -124,14 +124,16 @@ class ModelCheck:
         """Queue the spatial runs of design d (scaled) for every bird, once per label."""
         self.submit_setups(label, [m.space.setup(d) for m in population.members])
 
-    def submit_setups(self, label: str, setups: list[GraspSetup]) -> None:
-        """Queue the spatial runs of ``setups``, once per label."""
+    def submit_setups(self, label: str, setups: list[GraspSetup],
+                      integrator: IntegratorSettings | None = None) -> None:
+        """Queue the spatial runs of ``setups``, once per label, on
+        ``integrator`` (None: the check's)."""
         if label in self._runs:
             return
         tasks = []
         for setup in setups:
             task = Path(self._folder.name) / f"{len(self._tasks) + len(tasks) + 1}.task"
-            task.write_bytes(pickle.dumps((setup, self.integrator)))
+            task.write_bytes(pickle.dumps((setup, integrator or self.integrator)))
             tasks.append(task)
         self._tasks += tasks
         if not self._processes:
