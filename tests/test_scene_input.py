@@ -276,3 +276,29 @@ def test_an_overflowing_stiffness_profile_is_one_problem(tmp_path, capsys):
     assert capsys.readouterr().err == (
         f"error: {path}: finger.I: the rigidity from I is not positive and finite at s = "
         f"0.071 m, inside the finger (length 0.2 m); accepted: > 0 N m^2 on [0, length]\n")
+
+
+def test_a_written_grasper_reads_back_with_its_finger_sets():
+    """A grasp written into a scene (optimum.yaml) reads back as the same
+    grasper: every finger at the same mount, each copy still a copy of its
+    designed finger (what belt slots and design variables name) and the
+    drums' number of sets (what the line-speed rules use); a grasper whose
+    sets are not copies (one changed alone) is written finger by finger."""
+    from dataclasses import replace
+
+    from design.io.grasp_scene import GraspSettings
+    from design.io.scene_writer import grasp_spec
+    from design.run.grasp import setup_of
+
+    setup = setup_of(design.check(ROOT / "problems" / "grasp_mean_bird_hard_spatial.yaml").value)
+    assert setup.grasper.sets == 3
+    spec = grasp_spec(setup, GraspSettings(), "again", "")
+    assert spec["grasper"]["sets"] == 3 and len(spec["grasper"]["fingers"]) == 5
+    again = setup_of(design.check(spec).value).grasper
+    assert again.sets == 3
+    assert [(f.name, f.design_name, f.mount) for f in again.fingers] == \
+        [(f.name, f.design_name, f.mount) for f in setup.grasper.fingers]
+    moved = setup.grasper.with_finger(7, replace(setup.grasper.fingers[7], mount=replace(
+        setup.grasper.fingers[7].mount, angle=setup.grasper.fingers[7].mount.angle + 0.1)))
+    spec = grasp_spec(replace(setup, grasper=moved), GraspSettings(), "moved", "")
+    assert "sets" not in spec["grasper"] and len(spec["grasper"]["fingers"]) == 15

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import yaml
 
 from design.io.grasp_scene import GraspSettings
 from design.physics.beam import Finger
+from design.physics.grasper import GraspFinger, Grasper, mounted_sets
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import GraspSetup
 
@@ -33,6 +36,27 @@ def finger_spec(finger: Finger) -> dict:
     return out
 
 
+def fingers_spec(g: Grasper) -> dict:
+    """The grasper's fingers as a scene file holds them: the designed set and
+    ``sets`` where every other set is its copy (as the file reads back: the
+    copies' design names, their drums' sets), else every finger."""
+    rows = [finger_row(gf) for gf in g.fingers]
+    if g.sets > 1:
+        designed = [replace(gf, name=gf.design_name, family="", phase=0.0)
+                    for gf in g.fingers if gf.phase == 0.0]
+        if [finger_row(gf) for gf in mounted_sets(designed, g.sets)] == rows:
+            return {"sets": g.sets, "fingers": [finger_row(gf) for gf in designed]}
+    return {"fingers": rows}
+
+
+def finger_row(gf: GraspFinger) -> dict:
+    """One finger of a scene file's grasper (SI)."""
+    return {"name": gf.name, "group": gf.group, "length": gf.finger.length,
+            "height": gf.mount.height, "drum_radius": gf.mount.radius,
+            "angle": gf.mount.angle, "phi_x": gf.mount.phi_x, "phi_y": gf.mount.phi_y,
+            "finger": finger_spec(gf.finger)}
+
+
 def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, description: str) -> dict:
     """The content of a grasp scene file for ``setup`` (SI numbers only)."""
     g, b, c, i = setup.grasper, setup.bird, setup.conveyor, settings.integrator
@@ -43,11 +67,7 @@ def grasp_spec(setup: GraspSetup, settings: GraspSettings, name: str, descriptio
                         else {"start_position": c.start_position})
     return {
         "kind": "grasp", "name": name, "description": description,
-        "grasper": {"spacing": g.spacing, "tilt": g.tilt, "x": g.x, "fingers": [
-            {"name": gf.name, "group": gf.group, "length": gf.finger.length,
-             "height": gf.mount.height, "drum_radius": gf.mount.radius,
-             "angle": gf.mount.angle, "phi_x": gf.mount.phi_x, "phi_y": gf.mount.phi_y,
-             "finger": finger_spec(gf.finger)} for gf in g.fingers]},
+        "grasper": {"spacing": g.spacing, "tilt": g.tilt, "x": g.x, **fingers_spec(g)},
         "bird": {"name": b.name, "semi_axes": [b.eta, b.lam, b.gamma], "mass": b.mass,
                  "inertia_y": b.inertia},
         "conveyor": conveyor,
