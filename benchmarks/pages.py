@@ -329,8 +329,8 @@ def multistart(path: Path, data: dict) -> list[str]:
     single, base = data["single_start_hold_time_s"], data["baseline_hold_time_s"]
     lines = [f"`{data['command']}`: {data['status']} in {data['wall_time_s']:.0f} s; the best "
              f"verified hold {data['best_verified_hold_time_s']:.4f} s is "
-             f"{data['best_over_single_start']:.3g}x the single start's ({single:.4f} s, the "
-             f"main job's path) and {data['best_over_baseline']:.3g}x the baseline design's "
+             f"{data['best_over_single_start']:.3f}x the single start's ({single:.4f} s, the "
+             f"main job's path) and {data['best_over_baseline']:.3f}x the baseline design's "
              f"({base:.4f} s), cap {data['cap_N']:.2f} N. Every start:", "", *table(
                  data["starts"], {
                      "start": lambda r: r["start"], "status": lambda r: r["status"],
