@@ -165,6 +165,18 @@ class ContactFailed(RuntimeError):
         self.t, self.finger, self.reason = t, finger, message
 
 
+class OverBudget(RuntimeError):
+    """The belt continuations' Newton rootfinder calls passed the run's
+    budget (IntegratorSettings.max_newton_solves per simulated second): the
+    run stops there, as soon as the count passes it after its first instant
+    (which is always kept)."""
+
+    def __init__(self, t: float, solves: int, per_second: float):
+        super().__init__(f"stopped at t = {t:.4f} s: the belt continuations called their Newton "
+                         f"rootfinder {solves} times, over the budget of {per_second:g} per "
+                         f"simulated second")
+
+
 class PlanarFinger:
     """The thesis's finger (§4.3): rigid out of its bending plane; the plane
     cuts the bird in an ellipse, the planar contact is solved in it and only
@@ -457,6 +469,9 @@ class FingerForces:
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved
         self.skipped = 0           # finger evaluations the reach windows saved
+        #: (the run's most belt-continuation rootfinder calls, the budget per
+        #: simulated second) or None: no budget (:class:`OverBudget`)
+        self.budget: tuple[float, float] | None = None
         self._memo: dict = {}      # trial evaluations since the last commit
         self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
         self._frames: dict = {}    # t -> every finger's frame, for the latest times
@@ -598,6 +613,8 @@ class FingerForces:
             loads.qx += 2 * force[0]
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
+        if self.budget is not None and t > 0.0 and (solves := self.newton_solves) > self.budget[0]:
+            raise OverBudget(t, solves, self.budget[1])
         return loads, states
 
     def _kept(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, force: np.ndarray,
