@@ -79,3 +79,22 @@ def test_the_scenes_run_as_design_simulate_runs_them_within_the_loops_budget():
         == (1e-4, 1e-6, 1e-2)
     assert used.max_newton_solves == problem.settings.simulator.max_newton_solves == 2000
     assert problem.settings.simulator.rtol == 1e-6
+
+
+def test_a_design_run_queues_the_scenes_on_that_simulator():
+    """What the design run hands its background process: every case's scene
+    for the design, on the scene's own simulator with the loop's budget."""
+    from design.run.solve import design_space, submit_robustness
+
+    class Queue:
+        def submit_setups(self, label, setups, integrator):
+            self.queued = label, setups, integrator
+
+    problem = load_scene(ROOT / "problems" / "hold_time.yaml")
+    space = design_space(problem)
+    d0 = space.scale(space.base_values)
+    queue = Queue()
+    submit_robustness(problem, space, queue, "baseline", d0)
+    label, setups, integrator = queue.queued
+    assert label == "baseline" and setups == scenes(space.setup(d0))
+    assert integrator == simulator(problem.scene.settings.integrator)

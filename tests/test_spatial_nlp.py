@@ -219,7 +219,8 @@ def test_the_nlp_finger_on_the_belt_is_the_simulators(finger_5a_on_the_belt):
 def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget():
     """The count of the belt continuations' rootfinder calls is the run's own
     (the same on every machine): a budget below it stops the run, not ok,
-    saying where and why; the unlimited run goes to its end."""
+    saying where and why, as soon as the count passes it; the unlimited run
+    goes to its end."""
     setup, run = prefetch.result(ON_THE_BELT, on_the_belt)
     assert run.summary["ok"]
     stopped = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=1e-6),
@@ -228,3 +229,9 @@ def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget():
     assert re.search(r"Newton rootfinder \d+ times, over the budget of 1e-06 per simulated "
                      r"second", stopped.summary["message"])
     assert stopped.trajectory.records[-1].t < run.trajectory.records[-1].t
+    # a budget of 20 calls in the run stops it as the count passes 20, not a
+    # step later (one evaluation adds a call or two; a step of six stages more)
+    twenty = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=20 / setup.duration),
+                            SPATIAL_NODES)
+    calls = int(re.search(r"rootfinder (\d+) times", twenty.summary["message"]).group(1))
+    assert not twenty.summary["ok"] and 20 < calls <= 23

@@ -128,8 +128,7 @@ def _run(problem: DesignProblem, progress: Progress | None, study: StudyOptions 
     if problem.model_check != "none":
         check.submit(BASELINE, population, d0)
     if problem.robustness:
-        check.submit_setups(ROBUST_BASELINE, robustness.scenes(space.setup(d0)),
-                            robustness.simulator(problem.scene.settings.integrator))
+        submit_robustness(problem, space, check, ROBUST_BASELINE, d0)
     say("simulating the baseline at 4x the optimiser's resolution"
         + (f" for {len(population.members)} birds" if problem.population else ""))
     with profile.phase(VERIFICATION):
@@ -197,7 +196,7 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
     model_check, robust = None, None
     optimum = entries[0]["status"] in (VERIFIED, FAILED)        # else no optimum to check
     if problem.robustness and optimum:
-        submit_robustness(problem, space, check, entries[0]["case"], fine.d)
+        submit_robustness(problem, space, check, robust_optimum(entries[0]["case"]), fine.d)
     if problem.model_check != "none" and optimum:
         check.submit(entries[0]["case"], population, fine.d)
         with profile.phase(MODEL_CHECK):
@@ -337,7 +336,7 @@ def solve_case(problem: DesignProblem, progress: Progress | None, check: ModelCh
     if check and k == 0 and problem.model_check != "none":
         check.submit(case.key, population, outcome.best.d)
     if check and k == 0 and problem.robustness and problem.multistart.starts == 1:
-        submit_robustness(problem, space, check, case.key, outcome.best.d)
+        submit_robustness(problem, space, check, robust_optimum(case.key), outcome.best.d)
     say("verifying at 4x finer resolution")
     with outcome.profile.phase(VERIFICATION):
         fine = verify(population, outcome.best.d, settings,
@@ -749,8 +748,9 @@ def robust_optimum(key: str) -> str:
     return f"robustness: optimum of {key}"
 
 
-def submit_robustness(problem: DesignProblem, space: DesignSpace, check: ModelCheck, key: str,
-                      d: np.ndarray) -> None:
-    """Queue the robustness scenes of case ``key``'s scaled design ``d`` (once)."""
-    check.submit_setups(robust_optimum(key), robustness.scenes(space.setup(d)),
+def submit_robustness(problem: DesignProblem, space: DesignSpace, check: ModelCheck,
+                      label: str, d: np.ndarray) -> None:
+    """Queue the robustness scenes of the scaled design ``d`` as ``label``
+    (once), on the scene's own simulator (robustness.simulator)."""
+    check.submit_setups(label, robustness.scenes(space.setup(d)),
                         robustness.simulator(problem.scene.settings.integrator))
