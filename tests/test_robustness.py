@@ -11,6 +11,7 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
+from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.optimize.robustness import (CASES, robustness_text, scenes, simulator,
                                               table)
 
@@ -55,7 +56,9 @@ def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_
     base = [run(0.35, 19.0)] * n
     opt = [run(0.40, 19.0), run(0.34, 18.0), run(0.40, 20.3), run(0.40, 18.0, ["finger 5b ..."]),
            run(0.40, 18.0, ok=False)] + [run(0.40, 20.1)] * (n - 5)
-    t = table(base, opt, 20.0)
+    t = table(base, opt, 20.0, simulator(IntegratorSettings()))
+    assert t["model"] == {"finger_model": "spatial", "rtol": 1e-4, "atol_m": 1e-6,
+                          "max_step_s": 1e-2, "max_newton_solves_per_s": 2000}
     beats = [r["optimum_beats_baseline"] for r in t["cases"]]
     assert beats[:5] == [True, False, False, False, False] and all(beats[5:])
     assert t["share_beaten"] == pytest.approx((n - 4) / n)

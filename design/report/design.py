@@ -236,8 +236,10 @@ def robustness_section(page: Page, robust: dict) -> None:
     page.text(f"{robustness_text(robust)[0].upper()}{robustness_text(robust)[1:]} (target: "
               f"{robust['target_share']:.0%}). Each scene changes one thing the design problem "
               f"fixes; the optimum beats the baseline where it holds longer, stays under the "
-              f"{robust['cap_N']:.2f} N cap and does not jam. Both designs run on the "
-              f"scene's own simulator, as design simulate runs it.")
+              f"{robust['cap_N']:.2f} N cap and does not jam. Both designs run with the "
+              f"{robust['model']['finger_model']} finger on the scene's own simulator (rtol "
+              f"{robust['model']['rtol']:g}, steps up to {robust['model']['max_step_s']:g} s), "
+              f"as design simulate runs it.")
     page.table([{"scene": r["case"],
                  "baseline hold (s)": r["baseline_hold_time_s"],
                  "optimum hold (s)": r["optimum_hold_time_s"],
