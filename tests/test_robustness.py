@@ -11,7 +11,6 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
-from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.optimize.robustness import (CASES, robustness_text, scenes, simulator,
                                               table)
 
@@ -44,9 +43,15 @@ def test_each_scene_changes_what_it_names(scene_setups):
     assert base.belt.solid
 
 
+#: what spatial_summary says of the model a run used
+MODEL = {"finger_model": "spatial", "rtol": 1e-4, "atol_m": 1e-6, "max_step_s": 1e-2,
+         "max_newton_solves_per_s": 2000}
+
+
 def run(hold: float, peak: float, jam: list | None = None, ok: bool = True) -> dict:
     return {"hold_time_s": hold, "max_finger_force_N": peak, "max_finger_force_finger": "5b",
-            "jam": jam or [], "ok": ok, "message": "" if ok else "finger 5b's contact failed"}
+            "jam": jam or [], "ok": ok, "message": "" if ok else "finger 5b's contact failed",
+            "model": MODEL}
 
 
 def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_unjammed():
@@ -56,9 +61,8 @@ def test_the_optimum_beats_the_baseline_only_when_it_holds_longer_under_the_cap_
     base = [run(0.35, 19.0)] * n
     opt = [run(0.40, 19.0), run(0.34, 18.0), run(0.40, 20.3), run(0.40, 18.0, ["finger 5b ..."]),
            run(0.40, 18.0, ok=False)] + [run(0.40, 20.1)] * (n - 5)
-    t = table(base, opt, 20.0, simulator(IntegratorSettings()))
-    assert t["model"] == {"finger_model": "spatial", "rtol": 1e-4, "atol_m": 1e-6,
-                          "max_step_s": 1e-2, "max_newton_solves_per_s": 2000}
+    t = table(base, opt, 20.0)
+    assert t["model"] == MODEL
     beats = [r["optimum_beats_baseline"] for r in t["cases"]]
     assert beats[:5] == [True, False, False, False, False] and all(beats[5:])
     assert t["share_beaten"] == pytest.approx((n - 4) / n)
@@ -101,3 +105,19 @@ def test_a_design_run_queues_the_scenes_on_that_simulator():
     label, setups, integrator = queue.queued
     assert label == "baseline" and setups == scenes(space.setup(d0))
     assert integrator == simulator(problem.scene.settings.integrator)
+
+
+def test_each_run_records_the_model_it_ran_on(scene_setups):
+    """A robustness run says which finger model and simulator it used (what
+    result.json's robustness.model reports): those it was handed."""
+    from dataclasses import replace
+
+    from design.solvers.grasp.integrate import IntegratorSettings
+    from design.solvers.optimize.model_check import spatial_summary
+
+    base, _ = scene_setups
+    used = simulator(IntegratorSettings(rtol=3e-4, atol=2e-6, max_step=4e-3))
+    out = spatial_summary(replace(base, duration=0.02), used)
+    assert out["ok"] and out["model"] == {"finger_model": "spatial", "rtol": 3e-4,
+                                          "atol_m": 2e-6, "max_step_s": 4e-3,
+                                          "max_newton_solves_per_s": 2000}

@@ -206,8 +206,7 @@ def _assemble(problem: DesignProblem, space: DesignSpace, population: Population
         with profile.phase(ROBUSTNESS):
             robust = robustness.table(check.runs(ROBUST_BASELINE),
                                       check.runs(robust_optimum(entries[0]["case"])),
-                                      float(caps[0][0]),
-                                      robustness.simulator(problem.scene.settings.integrator))
+                                      float(caps[0][0]))
     with profile.phase(RESULT):
         output = _output(problem, space, [entries[k] for k in range(len(caps))], fine,
                          baseline, t0, model_check)

@@ -53,7 +53,7 @@ BASELINE = "baseline"
 
 def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
     """The setup simulated with the spatial finger: hold, peak and the
-    run's own validity problems (SI), and its CPU time."""
+    run's own validity problems (SI), the model it ran on, and its CPU time."""
     t0 = time.process_time()
     run = simulate_grasp(replace(setup, finger_model=CHECK_MODEL), integrator, SPATIAL_NODES)
     s = run.summary
@@ -63,6 +63,9 @@ def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
             "max_finger_force_time_s": float(s["max_finger_force_time_s"]),
             "ok": s["ok"], "message": s["message"], "jam": s["jam"],
             "model_warnings": validity_problems(s["validity"]),
+            "model": {"finger_model": CHECK_MODEL, "rtol": integrator.rtol,
+                      "atol_m": integrator.atol, "max_step_s": integrator.max_step,
+                      "max_newton_solves_per_s": integrator.max_newton_solves},
             "cpu_time_s": time.process_time() - t0}
 
 

@@ -26,7 +26,6 @@ from design.io.grasp_scene import read_bird
 from design.physics.belt import Belt
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import GraspSetup
-from design.solvers.optimize.model_check import CHECK_MODEL
 from design.solvers.optimize.trust_region import CAP_TOLERANCE, LOOP_NEWTON_SOLVES
 
 #: the share of the cases in which the optimum should beat the baseline
@@ -95,13 +94,13 @@ def scenes(setup: GraspSetup) -> list[GraspSetup]:
     return [change(setup) for _, change in CASES]
 
 
-def table(baseline: list[dict], optimum: list[dict], cap: float,
-          integrator: IntegratorSettings) -> dict:
+def table(baseline: list[dict], optimum: list[dict], cap: float) -> dict:
     """result.json's ``robustness`` from the two designs' runs of every case
     (design/solvers/optimize/model_check.py's spatial_summary, in CASES
-    order, on ``integrator``): each case's holds, peaks and jams (or why a
-    run ended early), whether the optimum beats the baseline there, the
-    share of the cases in which it does, and the model the runs used."""
+    order): each case's holds, peaks and jams (or why a run ended early),
+    whether the optimum beats the baseline there, the share of the cases in
+    which it does, and the model the runs used (the first run's: all are
+    queued on one)."""
     rows = []
     for (name, _), b, o in zip(CASES, baseline, optimum):
         why = _why_not(b, o, cap)
@@ -114,9 +113,7 @@ def table(baseline: list[dict], optimum: list[dict], cap: float,
                      "optimum_beats_baseline": not why, "why_not": "; ".join(why)})
     share = float(np.mean([r["optimum_beats_baseline"] for r in rows]))
     return {"cap_N": cap, "cases": rows, "share_beaten": share, "target_share": TARGET_SHARE,
-            "model": {"finger_model": CHECK_MODEL, "rtol": integrator.rtol,
-                      "atol_m": integrator.atol, "max_step_s": integrator.max_step,
-                      "max_newton_solves_per_s": integrator.max_newton_solves},
+            "model": baseline[0]["model"],
             "broken_by": [r["case"] for r in rows if not r["optimum_beats_baseline"]]}
 
 
