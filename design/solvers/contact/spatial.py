@@ -36,7 +36,7 @@ from design.solvers.beam.rod import RodStiffness
 from design.solvers.contact.robust import (BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS,
                                          PENETRATION_TOL, follow)
 from design.solvers.contact.spatial_equations import MODES, spatial_transcription
-from design.solvers.buffers import evaluate
+from design.solvers.buffers import Buffered, evaluate
 from design.solvers.newton import implicit_rate
 
 #: the straight finger enters the object over less than grazing_shift's grid
@@ -255,6 +255,10 @@ class SpatialContact:
         #: the parameters that follow the quadric and friction law (mesh, stiffness)
         self.tail = np.concatenate([self.widths, self.stiffness.params])
         self.tr = {m: spatial_transcription(self.stiffness, intervals, degree, m) for m in MODES}
+        #: each mode's post values (and residual size) and shape, called through
+        #: buffers of this solver's own (design/solvers/buffers.py)
+        self.post = {m: Buffered(self.tr[m].post) for m in MODES}
+        self.shape = {m: Buffered(self.tr[m].shape) for m in MODES}
         self.newton_iterations = 0
         self._last_iterations = 0
 
@@ -302,7 +306,7 @@ class SpatialContact:
         q = self._params(state.quadric, state.friction)
         post = state.post
         point, arc = post[:3], float(post[4])
-        _, r, _ = (np.asarray(v) for v in tr.shape(state.z, q))
+        _, r, _ = self.shape[state.mode](state.z, q)
         if arc < self.finger.length:
             rest = np.linspace(0.0, self.finger.length - arc, 6)[1:]
             r = np.hstack([r, point[:, None] + post[13:16, None] * rest[None, :]])
@@ -326,7 +330,7 @@ class SpatialContact:
         z = tr.chord.solve(previous.z, q, previous.inverse, self.tolerance, CHORD_ITERATIONS)
         if z is None:
             return None
-        post = np.asarray(tr.post(z, q)[0]).ravel()
+        post = self.post[previous.mode](z, q)[0].ravel()
         if self._check(previous.mode, post) != "ok":
             return None
         return SpatialState(previous.mode, z, quadric, friction, post)
@@ -415,7 +419,7 @@ class SpatialContact:
         else:
             mode, extra = "tip", [0.0]
         z = np.concatenate([rod.straight(), extra])
-        post = np.asarray(self.tr[mode].post(z, self._params(start, friction))[0]).ravel()
+        post = self.post[mode](z, self._params(start, friction))[0].ravel()
         state = SpatialState(mode, z, start, friction, post)
         return self._continue(state, quadric, friction)
 
@@ -459,7 +463,7 @@ class SpatialContact:
         stats = rf.stats()
         self._last_iterations = int(stats.get("iter_count", 0))
         self.newton_iterations += self._last_iterations
-        post, resid = (np.asarray(v).ravel() for v in tr.post(z, q))
+        post, resid = (v.ravel() for v in self.post[mode](z, q))
         ok = bool(stats.get("success", False)) and np.isfinite(resid[0]) \
             and resid[0] < RESIDUAL_TOL
         return z, ok, post
