@@ -491,3 +491,34 @@ def test_a_rod_state_split_where_the_bird_touches_and_joined_again_is_itself():
     for u in (0.23, 0.5, 0.81):
         first, second = spatial._split(w, u)
         np.testing.assert_allclose(spatial._join(first, second, u), w, atol=1e-13)
+
+
+def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
+    """As a simulation's trial evaluations do, the finger resting on the belt
+    is continued from one belt-only state into the bird three times, the bird
+    a few micrometres apart: the first switch into interior+belt needs a
+    Newton solve, the later ones none (the chord method with that mode's
+    latest Jacobian inverse), and each contact is a fresh solver's to 1e-12 N."""
+    finger = Finger(LENGTH, thesis_finger().stiffness)
+    plane = Plane(np.array([*NORMAL, 0.0]), belt_offset(7.3e-3))
+
+    def bird(height: float) -> Quadric:
+        return Quadric(np.array([0.10, height, 0.0]),
+                       np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
+
+    def resting(solver: SpatialBeltContact) -> Belted:
+        _, state = solver.solve(bird(0.07), FrictionLaw(), plane, spatial_law(0.0))
+        assert state.mode == "belt"
+        return state
+
+    solver = SpatialBeltContact(SpatialContact(finger, intervals=8))
+    start = resting(solver)
+    for height, newton in ((0.042, 1), (0.042 - 1e-6, 0), (0.042 - 2e-5, 0)):
+        before = solver.newton_total
+        sol, state = solver.solve(bird(height), FrictionLaw(), plane, spatial_law(0.0), start)
+        assert state.mode == "interior+belt" and solver.newton_total - before == newton
+        fresh = SpatialBeltContact(SpatialContact(finger, intervals=8))
+        alone, _ = fresh.solve(bird(height), FrictionLaw(), plane, spatial_law(0.0),
+                               resting(fresh))
+        assert sol.normal_force == pytest.approx(alone.normal_force, abs=1e-12)
+        assert sol.belt_normal_force == pytest.approx(alone.belt_normal_force, abs=1e-12)

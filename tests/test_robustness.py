@@ -11,8 +11,14 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
-from design.solvers.optimize.robustness import (CASES, robustness_text, scenes, simulator,
-                                              table)
+from design.solvers.optimize.robustness import (
+    CASES,
+    robustness_text,
+    scenes,
+    simulator,
+    table,
+)
+from design.solvers.optimize.trust_region import LOOP_NEWTON_SOLVES
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -45,7 +51,7 @@ def test_each_scene_changes_what_it_names(scene_setups):
 
 #: what spatial_summary says of the model a run used
 MODEL = {"finger_model": "spatial", "rtol": 1e-4, "atol_m": 1e-6, "max_step_s": 1e-2,
-         "max_newton_solves_per_s": 2000}
+         "max_newton_solves_per_s": LOOP_NEWTON_SOLVES}
 
 
 def run(hold: float, peak: float, jam: list | None = None, ok: bool = True) -> dict:
@@ -84,7 +90,8 @@ def test_the_scenes_run_as_design_simulate_runs_them_within_the_loops_budget():
     used = simulator(own)
     assert (used.rtol, used.atol, used.max_step) == (own.rtol, own.atol, own.max_step) \
         == (1e-4, 1e-6, 1e-2)
-    assert used.max_newton_solves == problem.settings.simulator.max_newton_solves == 2000
+    assert used.max_newton_solves == problem.settings.simulator.max_newton_solves \
+        == LOOP_NEWTON_SOLVES
     assert problem.settings.simulator.rtol == 1e-6
 
 
@@ -120,4 +127,4 @@ def test_each_run_records_the_model_it_ran_on(scene_setups):
     out = spatial_summary(replace(base, duration=0.02), used)
     assert out["ok"] and out["model"] == {"finger_model": "spatial", "rtol": 3e-4,
                                           "atol_m": 2e-6, "max_step_s": 4e-3,
-                                          "max_newton_solves_per_s": 2000}
+                                          "max_newton_solves_per_s": LOOP_NEWTON_SOLVES}

@@ -12,7 +12,10 @@ their new values in one step; where Newton cannot take it, in steps that
 halve on failure and double on success (first the geometry under the old
 laws, then the laws, as the bird-only solvers do); where a contact starts
 inside it, along its own path to where the contact starts and on in one
-step from there. After every step the contacts are checked:
+step from there. Each solve is the chord method with the latest Jacobian
+inverse of its mode, Newton where that does not converge (a mode's first
+solve after a switch no longer pays for a Newton solve and a
+factorisation). After every step the contacts are checked:
 
 * a contact whose normal force would pull lets go;
 * the tip passing below the belt, or the finger entering the bird, starts a
@@ -199,6 +202,8 @@ class BeltedContact:
         #: every call (where the chord method did not converge: the costly ones)
         self.newton_iterations = self.newton_total = 0
         self._calls: dict = {}
+        #: mode -> the Jacobian inverse at the latest root Newton found in it
+        self._inverses: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None) -> tuple[Belted | None, str]:
         """The state at ``target``'s bird, belt and laws, continued from
@@ -339,21 +344,29 @@ class BeltedContact:
 
     def _newton(self, state: Belted) -> Belted | None:
         """Newton in the state's mode at its parameters from its z; None when
-        it does not converge within MAX_STEP_ITERATIONS."""
+        it does not converge within MAX_STEP_ITERATIONS. The chord method
+        goes first, with the state's Jacobian inverse or else its mode's
+        latest in this continuation (a state switched into a mode has none);
+        where Newton takes over, the inverse at its root becomes the mode's
+        latest. The state solved carries the inverse it was solved with."""
         if state.mode == "free":
             return state
         newton, post = self.calls(state.mode)[:2]
         q = self.q(state)
-        z = None if state.inverse is None else self.transcription(state.mode).chord.solve(
-            state.z, q, state.inverse, self.tolerance, CHORD_ITERATIONS)
+        chord = self.transcription(state.mode).chord
+        inverse = state.inverse if state.inverse is not None else self._inverses.get(state.mode)
+        z = None if inverse is None else chord.solve(state.z, q, inverse, self.tolerance,
+                                                     CHORD_ITERATIONS)
         if z is None:
-            z = newton(state.z, q)[0].ravel()
+            z, inverse = newton(state.z, q)[0].ravel(), None
             self.newton_total += 1
         self.newton_iterations += 1
         post, resid = (v.ravel() for v in post(z, q))
         if not (np.isfinite(resid[0]) and resid[0] < 1e-8):
             return None
-        return self.solved(replace(state, z=z, inverse=None), post)
+        if inverse is None:
+            inverse = self._inverses[state.mode] = chord.inverse(z, q)
+        return self.solved(replace(state, z=z, inverse=inverse), post)
 
     def with_inverse(self, state: Belted) -> Belted:
         """The state with its Jacobian inverse, for continuing by the chord method."""

@@ -5,7 +5,7 @@ solver options under the solve layer's policy, whoever built the problem
 >>> from design.io.grasp_scene import GraspSettings
 >>> s = loop_settings({"time_step": 0.01}, GraspSettings(contact_nodes=3))
 >>> s.nlp.time_step, s.nlp.beam_intervals, s.simulator.max_step, s.simulator.max_newton_solves
-(0.01, 3, 0.01, 2000)
+(0.01, 3, 0.01, 300)
 """
 
 from __future__ import annotations
