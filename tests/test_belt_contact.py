@@ -145,6 +145,17 @@ def test_a_round_finger_presses_the_same_whichever_way_the_belt_lies_about_it(an
     np.testing.assert_allclose(p, turn @ tip, atol=1e-9)
 
 
+#: the belt in the spatial finger's frame with the straight tip 7.3 mm below it
+PRESSED_BELT = Plane(np.array([*NORMAL, 0.0]), belt_offset(7.3e-3))
+
+
+def pressing_bird(height: float) -> Quadric:
+    """The ellipsoid of :func:`pressing_sweep` (semi-axes 50, 40 and 60 mm)
+    with its centre ``height`` (m) above the finger's base line."""
+    return Quadric(np.array([0.10, height, 0.0]),
+                   np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
+
+
 def pressing_sweep(model: str):
     """A bird (ellipse/ellipsoid of semi-axes 50 and 40 mm, 60 mm deep) lowered
     onto the thesis finger resting 7.3 mm deep on the belt, then raised
@@ -159,11 +170,8 @@ def pressing_sweep(model: str):
             sol, state = planar.solve(conic, 0.0, Plane(NORMAL, plane), planar_law(0.0), state)
             belt = sol.belt_normal_force
         else:
-            quadric = Quadric(np.array([0.10, yc, 0.0]),
-                              np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
-            sol, state = spatial.solve(quadric, FrictionLaw(),
-                                       Plane(np.array([*NORMAL, 0.0]), plane), spatial_law(0.0),
-                                       state)
+            sol, state = spatial.solve(pressing_bird(yc), FrictionLaw(), PRESSED_BELT,
+                                       spatial_law(0.0), state)
             belt = sol.belt_normal_force
         assert sol.converged, sol.message
         out.append((yc, state, sol, belt))
@@ -500,14 +508,10 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
     Newton solve, the later ones none (the chord method with that mode's
     latest Jacobian inverse), and each contact is a fresh solver's to 1e-12 N."""
     finger = Finger(LENGTH, thesis_finger().stiffness)
-    plane = Plane(np.array([*NORMAL, 0.0]), belt_offset(7.3e-3))
-
-    def bird(height: float) -> Quadric:
-        return Quadric(np.array([0.10, height, 0.0]),
-                       np.diag([1 / 0.05 ** 2, 1 / 0.04 ** 2, 1 / 0.06 ** 2]))
 
     def resting(solver: SpatialBeltContact) -> Belted:
-        _, state = solver.solve(bird(0.07), FrictionLaw(), plane, spatial_law(0.0))
+        _, state = solver.solve(pressing_bird(0.07), FrictionLaw(), PRESSED_BELT,
+                                spatial_law(0.0))
         assert state.mode == "belt"
         return state
 
@@ -515,10 +519,11 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
     start = resting(solver)
     for height, newton in ((0.042, 1), (0.042 - 1e-6, 0), (0.042 - 2e-5, 0)):
         before = solver.newton_total
-        sol, state = solver.solve(bird(height), FrictionLaw(), plane, spatial_law(0.0), start)
+        sol, state = solver.solve(pressing_bird(height), FrictionLaw(), PRESSED_BELT,
+                                  spatial_law(0.0), start)
         assert state.mode == "interior+belt" and solver.newton_total - before == newton
         fresh = SpatialBeltContact(SpatialContact(finger, intervals=8))
-        alone, _ = fresh.solve(bird(height), FrictionLaw(), plane, spatial_law(0.0),
-                               resting(fresh))
+        alone, _ = fresh.solve(pressing_bird(height), FrictionLaw(), PRESSED_BELT,
+                               spatial_law(0.0), resting(fresh))
         assert sol.normal_force == pytest.approx(alone.normal_force, abs=1e-12)
         assert sol.belt_normal_force == pytest.approx(alone.belt_normal_force, abs=1e-12)
