@@ -11,13 +11,8 @@ import pytest
 
 from design.io.scene import load_scene
 from design.run.grasp import setup_of
-from design.solvers.optimize.robustness import (
-    CASES,
-    robustness_text,
-    scenes,
-    simulator,
-    table,
-)
+from design.solvers.optimize.robustness import (CASES, robustness_text, scenes, simulator,
+                                              table)
 from design.solvers.optimize.trust_region import LOOP_NEWTON_SOLVES
 
 ROOT = Path(__file__).resolve().parents[1]
