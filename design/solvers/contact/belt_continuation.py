@@ -223,6 +223,16 @@ class BeltedContact:
                   f"first touch" if msg else ""
         return fresh, msg
 
+    def clearance(self, state: Belted, target: Belted) -> float | None:
+        """How far (m) the finger of ``state`` (``free`` or ``belt``: not
+        touching the bird) is clear of ``target``'s bird, solved in its own
+        mode at ``target``'s belt and belt law (< 0: inside, where a
+        continuation to ``target`` would start the contact; None: not solved
+        in one step)."""
+        new = self._newton(replace(state, bird=target.bird, plane=target.plane,
+                                   belt=target.belt))
+        return None if new is None else -self.excess(new, "bird")
+
     def lowered(self, state: Belted) -> Belted:
         """A solved bird-only state (mode, z, bird, friction, belt) with the
         belt lowered to its tip: the belt then comes in from first touch."""

@@ -39,8 +39,8 @@ from design.solvers.contact.spatial_equations import MODES, spatial_transcriptio
 from design.solvers.buffers import Buffered, evaluate
 from design.solvers.newton import implicit_rate
 
-#: the straight finger enters the object over less than grazing_shift's grid
-#: resolves (l / 200): a touch without force, not a failure
+#: the straight finger is not inside the object at its deepest point (it
+#: touches it at most): a touch without force, not a failure
 GRAZES = "the straight finger only grazes the object"
 #: residual (dimensionless) below which a Newton solve counts as converged
 RESIDUAL_TOL = 1e-8
@@ -169,13 +169,18 @@ def no_spatial_contact(length: float, message: str, converged: bool = True) -> S
                            shape_points=pts)
 
 
+def deepest_along(quadric: Quadric, length: float) -> float:
+    """Where (m from the base) the straight finger (0 ≤ x ≤ l on the x axis)
+    goes deepest into the object: level(x e_x) is a parabola in x with its
+    minimum at x* = c·Q e_x / Q00, clipped to the finger."""
+    Q, c = quadric.matrix, quadric.center
+    return float(np.clip((Q[0] @ c) / Q[0, 0], 0.0, length))
+
+
 def segment_level(quadric: Quadric, length: float) -> float:
     """min over the straight finger (0 ≤ x ≤ l on the x axis) of the level
     function: < 0 when it passes through the object."""
-    Q, c = quadric.matrix, quadric.center
-    # level(x e_x) is a parabola in x with its minimum at x* = c·Q e_x / Q00
-    x_star = float(np.clip((Q[0] @ c) / Q[0, 0], 0.0, length))
-    xs = np.array([0.0, length, x_star])
+    xs = np.array([0.0, length, deepest_along(quadric, length)])
     return float(np.min(quadric.level(np.stack([xs, np.zeros(3), np.zeros(3)]))))
 
 
@@ -190,7 +195,9 @@ def grazing_shift(quadric: Quadric, length: float, samples: int = 72
     grid of angles and refined by golden sections.
     """
     Q, c = quadric.matrix, quadric.center
-    xs = np.linspace(0.0, length, 201)
+    # a grid along the finger and its deepest point: a finger only just inside
+    # the object, between two grid points, is inside at that one
+    xs = np.sort(np.append(np.linspace(0.0, length, 201), deepest_along(quadric, length)))
     # the finger's points relative to the centre, and their levels: the same for every v
     d = np.stack([xs, np.zeros_like(xs), np.zeros_like(xs)]) - c[:, None]
     c0 = np.einsum("in,ij,jn->n", d, Q, d) - 1.0

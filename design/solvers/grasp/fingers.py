@@ -29,16 +29,23 @@ The belt. A finger whose straight tip would pass below the belt's surface
 (design/physics/belt.py) rests on it: the belt pushes its tip up and drags
 it with friction at the finger-belt µ against the tip's sliding over the
 moving belt, and the bird meets the finger so bent. Such a finger is solved
-with the belt while it is inside its reach windows: at accepted instants
-always (its force on the belt is reported), in trial evaluations only while
-the bird comes within the tip's depth below the belt of the straight finger
-(the finger bends up by at most that much). A finger pushed into the belt
-by the bird is solved with the belt from then on.
+with the belt while it is inside its reach windows. A finger pushed into
+the belt by the bird is solved with the belt from then on.
+
+First touch (spatial fingers). An integrator's trial evaluations continue
+each contact from its last accepted state; a finger that did not touch the
+bird there is left out of them (it presses nothing), and the accepted
+instant that finds it inside the bird ends its step early: the integrator
+locates where the finger's clearance (:meth:`FingerForces.touch_margin`)
+crosses zero and accepts that instant instead, where the contact starts
+(design/solvers/grasp/integrate.py). So no step has a contact starting
+inside it, where the force's kink would make the stepper reject its step
+again and again, each try solving the first touch afresh.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -185,6 +192,8 @@ class PlanarFinger:
 
     name = "planar"
     from_committed = False
+    #: a trial may start a contact (continued from the latest trial's)
+    touches_at_commits = False
     #: the friction's sense follows the finger's sliding (settled at accepted steps)
     settles_friction = True
 
@@ -333,6 +342,9 @@ class SpatialFinger:
     from_committed = True
     #: friction solved with the contact, regularised: nothing to reverse
     reverses = False
+    #: no trial starts a contact: an integrator step ends where one starts
+    #: (:meth:`FingerForces.touch_margin`), and the accepted instant starts it
+    touches_at_commits = True
 
     def __init__(self, finger, friction: float, intervals: int, degree: int):
         self.solver = SpatialContact(finger, intervals=intervals, degree=degree)
@@ -371,6 +383,31 @@ class SpatialFinger:
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
+
+    @staticmethod
+    def touching(state) -> bool:
+        """Whether a solved state presses on the bird."""
+        return isinstance(state, SpatialState) or (isinstance(state, Belted)
+                                                   and state.mode in BIRD_MODES)
+
+    def clearance(self, body: Ellipsoid, base, R, start, belt=None) -> float | None:
+        """How far (m) the finger, not touching the bird at ``start``, is clear
+        of it (< 0: inside, where :meth:`solve` starts the contact): the
+        straight finger's, or the finger's on the belt solved in its mode;
+        None where that cannot be said without solving the contact."""
+        quadric = body_quadric(body, base, R)
+        resting = belt is not None and belt[0].level(
+            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        if isinstance(start, Belted) and (resting or start.mode in BELT_MODES):
+            if belt is None:
+                return None
+            target = Belted("free", None, quadric.params, start.friction, belt[0],
+                            FrictionLaw.of(belt[1]).params)
+            return self.belted.clearance(start, target)
+        if resting:
+            return None
+        level = segment_level(quadric, self.solver.finger.length)
+        return level / (2.0 * np.sqrt(np.linalg.eigvalsh(quadric.matrix).max()))
 
     def detailed(self, sol: SpatialSolution, state) -> tuple[SpatialSolution, object]:
         """A trial's solve with the detail its commit adds (the finger's shape,
@@ -473,6 +510,10 @@ class FingerForces:
         #: simulated second) or None: no budget (:class:`OverBudget`)
         self.budget: tuple[float, float] | None = None
         self._memo: dict = {}      # trial evaluations since the last commit
+        #: the fingers whose contact with the bird the latest commit started
+        #: (:meth:`touch_margin`)
+        self.touched: list[int] = []
+        self._committed = False    # an instant accepted
         self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
         self._frames: dict = {}    # t -> every finger's frame, for the latest times
         start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
@@ -566,56 +607,93 @@ class FingerForces:
     def evaluate(self, t: float, y: np.ndarray, commit: bool = False
                  ) -> tuple[Loads, list[FingerState]]:
         key = (t, y.tobytes())
-        trial = self._memo.get(key)
-        if not commit and trial is not None:
-            return trial
-        if commit and trial is not None and self._trials_from_committed:
-            out = self._commit_trial(t, y, trial)
+        memo = self._memo.get(key)
+        if not commit and memo is not None:
+            return memo[0]
+        waiting = self._waiting()
+        if commit and memo is not None and self._trials_from_committed:
+            out, skipped = self._commit_trial(t, y, *memo), ()
         else:
-            out = self._evaluate(t, y, commit)
+            out, skipped = self._evaluate(t, y, commit)
+        if self.budget is not None and t > 0.0 and (solves := self.newton_solves) > self.budget[0]:
+            raise OverBudget(t, solves, self.budget[1])
         if commit:
+            self.touched = [i for i in waiting if self.models[i].touching(self.states[i])]
+            self._committed = True
             self._memo.clear()
             self._margins.clear()
         elif len(self._memo) > 16:
             self._memo.pop(next(iter(self._memo)))
-        self._memo[key] = out
+        self._memo[key] = out, skipped
         return out
 
-    def _evaluate(self, t: float, y: np.ndarray, commit: bool) -> tuple[Loads, list[FingerState]]:
+    def _waiting(self) -> set[int]:
+        """The fingers whose contact starts only at an accepted instant
+        (``touches_at_commits``) that did not touch the bird at the last one
+        (none before the first: a bird may start in the fingers)."""
+        if not self._committed:
+            return set()
+        return {i for i, m in enumerate(self.models)
+                if m.touches_at_commits and not m.touching(self.states[i])}
+
+    def touch_margin(self, t: float, y: np.ndarray) -> float:
+        """The least clearance (m) from the bird at (t, y) of the fingers
+        waiting for a contact to start (:meth:`_waiting`) inside their reach
+        windows (inf: none can say). Below zero one of them touches: its
+        trials leave it out, so the integrator ends its step there and the
+        accepted instant starts the contact."""
+        body = self.ellipsoid(y)
+        waiting = self._waiting()
+        margins = [self.models[i].clearance(body, *self.frame(i, t), self.states[i],
+                                            self.belt_contact(i, t))
+                   for i in sorted(self.reaching(t, body) & waiting)]
+        return min([np.inf] + [m for m in margins if m is not None])
+
+    def _evaluate(self, t: float, y: np.ndarray, commit: bool
+                  ) -> tuple[tuple[Loads, list[FingerState]], list[int]]:
+        """Every finger solved at (t, y): (loads, states), and the fingers a
+        trial left out, waiting for their contact to start at an accepted
+        instant."""
         body = self.ellipsoid(y)
         loads, states = Loads(), []
-        centre = np.array([y[0], 0.0, y[1]])
         reaching = self.reaching(t, body)
+        waiting = set() if commit else self._waiting()
+        skipped = sorted(reaching & waiting)
         for i in range(len(self.models)):
-            force = None
-            if i in reaching:
-                base, R = self.frame(i, t)
-                # continue from the latest solution, trial or committed: the nearest
-                # in time (trials keep the committed friction); or, for a model whose
-                # friction is solved with the contact (spatial), always from the
-                # committed one, so that trials cannot wander onto another branch
-                model = self.models[i]
-                start = self.states[i] if commit or model.from_committed else self.trials[i]
-                force, p_w, sol, cont = model.solve(
-                    body, base, R, lambda shape, i=i: self._kinematics(i, t, y, shape), start,
-                    commit, self.belt_contact(i, t))
-            if force is None:                       # out of reach: no contact problem
-                self.trials[i] = None
-                if commit:
-                    self.states[i] = None
-                states.append(FingerState())
-                continue
-            self.solves += 1
-            states.append(self._kept(i, t, y, body, force, p_w, sol, cont, commit))
-            if p_w is None:
-                continue
-            r = p_w - centre
+            solved = self._solve(i, t, y, body, commit) if i in reaching - waiting else None
+            states.append(self._state(i, t, y, body, solved, commit, loads))
+        return (loads, states), skipped
+
+    def _solve(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, commit: bool):
+        """Finger i's model solved at (t, y): (force, point, solution, state)."""
+        base, R = self.frame(i, t)
+        # continue from the latest solution, trial or committed: the nearest
+        # in time (trials keep the committed friction); or, for a model whose
+        # friction is solved with the contact (spatial), always from the
+        # committed one, so that trials cannot wander onto another branch
+        model = self.models[i]
+        start = self.states[i] if commit or model.from_committed else self.trials[i]
+        return model.solve(body, base, R, lambda shape: self._kinematics(i, t, y, shape), start,
+                           commit, self.belt_contact(i, t))
+
+    def _state(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, solved, commit: bool,
+               loads: Loads) -> FingerState:
+        """Finger i's state from its solve (None: not solved, out of reach),
+        its force added to ``loads`` (both drums)."""
+        force, p_w, sol, cont = solved or (None,) * 4
+        if force is None:                           # out of reach: no contact problem
+            self.trials[i] = None
+            if commit:
+                self.states[i] = None
+            return FingerState()
+        self.solves += 1
+        state = self._kept(i, t, y, body, force, p_w, sol, cont, commit)
+        if p_w is not None:
+            r = p_w - np.array([y[0], 0.0, y[1]])
             loads.qx += 2 * force[0]
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
-        if self.budget is not None and t > 0.0 and (solves := self.newton_solves) > self.budget[0]:
-            raise OverBudget(t, solves, self.budget[1])
-        return loads, states
+        return state
 
     def _kept(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, force: np.ndarray,
               p_w: np.ndarray | None, sol, cont, commit: bool) -> FingerState:
@@ -632,24 +710,28 @@ class FingerForces:
         r = p_w - np.array([y[0], 0.0, y[1]])
         return FingerState(force, p_w, body.rotation.T @ r, sol, *shares, cont)
 
-    def _commit_trial(self, t: float, y: np.ndarray, trial: tuple[Loads, list[FingerState]]
-                      ) -> tuple[Loads, list[FingerState]]:
+    def _commit_trial(self, t: float, y: np.ndarray, trial: tuple[Loads, list[FingerState]],
+                      skipped: list[int]) -> tuple[Loads, list[FingerState]]:
         """Commit the trial evaluation at (t, y): where every trial continues
         from the committed contacts (``from_committed``), the trial solved
         what the commit would, and the commit only adds each solve's detail
-        and each contact's out-of-plane shares. (An adaptive Runge-Kutta
-        step's last stage is evaluated where the step ends, the instant
-        then accepted.)"""
+        and each contact's out-of-plane shares, and solves the fingers the
+        trial left out (``skipped``). (An adaptive Runge-Kutta step's last
+        stage is evaluated where the step ends, the instant then accepted.)"""
         loads, trial_states = trial
+        loads = replace(loads)
         body = self.ellipsoid(y)
         states = []
         for i, st in enumerate(trial_states):
-            if st.solution is None:                 # out of reach
+            if i in skipped:
+                states.append(self._state(i, t, y, body, self._solve(i, t, y, body, True), True,
+                                          loads))
+            elif st.solution is None:                 # out of reach
                 self.trials[i] = self.states[i] = None
                 states.append(st)
-                continue
-            sol, cont = self.models[i].detailed(st.solution, st.continued)
-            states.append(self._kept(i, t, y, body, st.force, st.point, sol, cont, True))
+            else:
+                sol, cont = self.models[i].detailed(st.solution, st.continued)
+                states.append(self._kept(i, t, y, body, st.force, st.point, sol, cont, True))
         return loads, states
 
     def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
@@ -660,7 +742,7 @@ class FingerForces:
         self.states, self.trials = list(snapshot[0]), list(snapshot[1])
         self._memo, self._margins = {}, {}
         try:
-            return self._evaluate(t, y, commit=False)[1]
+            return self._evaluate(t, y, commit=False)[0][1]
         finally:
             self.states, self.trials, self._memo, self._margins = kept
 

@@ -10,12 +10,15 @@ start and end of the conveyor's deceleration, and a finger's friction
 reversing (its sliding against its friction passing the reversal speed).
 Finger contacts are evaluated at every stage with the friction of the last
 accepted instant; each accepted instant settles it, and the stepper restarts
-when one turns. Located as an event, a reversal comes where the sliding
-says, not up to a step late, so the hold and peak force do not depend on
-where the steps fell (``python -m benchmarks.grasp``). A finger's force
-maxima between accepted instants are located on the dense output
-(design/solvers/grasp/peaks.py), so that the peak force does not depend on
-the step either.
+when one turns. A spatial finger's first touch of the bird is an event too:
+trials leave out a finger that did not touch the bird at the last accepted
+instant, and a step at whose end one touches it ends where its clearance
+crosses zero (design/solvers/grasp/fingers.py). Located as an event, a
+reversal comes where the sliding says, not up to a step late, so the hold
+and peak force do not depend on where the steps fell (``python -m
+benchmarks.grasp``). A finger's force maxima between accepted instants are
+located on the dense output (design/solvers/grasp/peaks.py), so that the
+peak force does not depend on the step either.
 
 BDF-4 (``bdf4``, thesis §4.4): fixed step h, forces frozen over the step,
 conveyor friction sign updated at the end of the step, the conveyor contact
@@ -191,6 +194,10 @@ EVENT_ARM = {"lift-off": 1e-9, "slip": 1e-9, "stick": 1e-9, "touch-down": 0.0,
 #: minus this (m/s), so that the contact solved again from the accepted
 #: state agrees, to rounding, that it turns (1e-9 to 1e-7 s past the crossing)
 REVERSAL_DEPTH = 1e-9
+#: a finger's first touch of the bird is committed where the finger is at
+#: least this far (m) inside it, so that the contact solved there starts
+#: (1e-9 to 2e-9 m inside: a few nanoseconds past the crossing)
+TOUCH_DEPTH = 1e-9
 #: this many events within a nanosecond is chattering: the run stops and says so
 MAX_EVENTS_AT_ONCE = 20
 #: a belt mode's normal force may dip below zero by this fraction of the
@@ -413,6 +420,17 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 t = _locate(grasp.fingers.reversal_margin, dense, t_old, t_new, REVERSAL_DEPTH)
                 traj.events.append((float(t), "friction reverses"))
                 committed = _commit(grasp, t, dense(t), mode, slip_sign)
+                restart = True
+            elif grasp.fingers.touched:
+                # a finger touched the bird within the step, where the trials left
+                # it out: the step ends where it first touches (a new smooth piece)
+                grasp.fingers.restore(snapshot)
+                t = _locate(grasp.fingers.touch_margin, dense, t_old, t_new, TOUCH_DEPTH)
+                # inside already where the step began (its solve there found no
+                # force): the contact starts where the step ends, as found
+                t = t_new if t <= t_old else t
+                traj.events.append((float(t), "a finger touches the bird"))
+                committed = _commit(grasp, t, y_new if t == t_new else dense(t), mode, slip_sign)
                 restart = True
             record, mode, slip_sign, y, _ = committed
             if not _keep(grasp, traj, record):
