@@ -8,7 +8,7 @@ from design.io.scene import load_scene
 from design.reproduce.grasp import MEAN_START, mean_bird_setup
 from design.run.grasp import setup_of
 from design.solvers.contact.belt_continuation import BIRD_MODES, Belted
-from design.solvers.grasp.fingers import FingerForces
+from design.solvers.grasp.fingers import RATE_STEP, FingerForces, body_quadric
 
 
 def fingers_of(setup) -> FingerForces:
@@ -80,3 +80,32 @@ def test_a_commit_keeps_the_trial_solved_at_its_instant():
             assert np.array_equal(k.continued.inverse, s.continued.inverse)
     nxt = [f.evaluate(0.008, y2)[0] for f in (reused, fresh)]
     assert (nxt[0].qx, nxt[0].qz, nxt[0].ty) == (nxt[1].qx, nxt[1].qz, nxt[1].ty)
+
+
+def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():
+    """A spatial finger's friction law takes the bird's surface velocity in
+    the finger frame as an affine field v0 + G p: at any point it is the
+    difference quotient over RATE_STEP of the point carried with the bird
+    and seen from the drum-turned frame (1e-8 m/s: rounding of positions of
+    0.1 m divided by the 1e-6 s step). The mean bird moving and pitching
+    at finger 4a."""
+    setup = mean_bird_setup("soft")
+    forces = fingers_of(setup)
+    b = setup.bird
+    y = np.array([MEAN_START, b.gamma + 0.002, 0.05, setup.conveyor.speed, -0.03, 0.8])
+    t, dt = 0.3, RATE_STEP
+    body = forces.ellipsoid(y)
+    i = [gf.name for gf in setup.grasper.fingers].index("4a")
+    base, R = forces.frame(i, t)
+    motion = forces._kinematics(i, t, y, body_quadric(body, base, R))
+    y2 = y.copy()
+    y2[:3] += dt * y[3:]
+    later = forces.ellipsoid(y2)
+    base2, R2 = forces.frame(i, t + dt)
+    for p in np.random.default_rng(0).uniform(-0.1, 0.1, (5, 3)):
+        p_w = base + R @ p
+        carried = np.asarray(later.center) + later.rotation @ (
+            body.rotation.T @ (p_w - np.asarray(body.center)))
+        expected = (R2.T @ (carried - base2) - p) / dt
+        np.testing.assert_allclose(motion(p)[1], expected, rtol=0, atol=1e-8)
+    assert np.linalg.norm(motion.gradient) > 0.5          # the pitch rate and drum turn show

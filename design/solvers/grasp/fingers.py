@@ -46,6 +46,7 @@ again and again, each try solving the first touch afresh.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -421,12 +422,9 @@ class SpatialFinger:
         against the rigid finger's sliding over the bird's surface."""
         if self.mu <= 0:
             return FrictionLaw()
-        # the object's velocity field is affine in the point: sample it at 0 and e_i
-        kin = kin_factory(quadric)
-        v0 = kin(np.zeros(3))[1]
-        gradient = np.column_stack([kin(e)[1] - v0 for e in np.eye(3)])
-        return FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-v0,
-                           sliding_gradient=-gradient)
+        motion = kin_factory(quadric)
+        return FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-motion.v0,
+                           sliding_gradient=-motion.gradient)
 
     def _tip(self, sol: SpatialSolution, state: SpatialState) -> np.ndarray:
         """The finger's tip (finger frame) in a bird-only contact."""
@@ -457,6 +455,24 @@ class ThesisPlanarFinger(PlanarFinger):
 
 #: contact models by name
 FINGER_MODELS = {m.name: m for m in (PlanarFinger, ThesisPlanarFinger, SpatialFinger)}
+
+
+class SurfaceMotion:
+    """The bird's motion in a finger frame over RATE_STEP (spatial fingers):
+    its surface's velocity relative to the frame, affine in the point, v(p)
+    = v0 + gradient p (m/s, finger frame), and the rates of its quadric's
+    parameters (computed when first asked for); called with a point, the
+    pair (rates, v(p)) (design.solvers.contact.spatial.Kinematics)."""
+
+    def __init__(self, v0: np.ndarray, gradient: np.ndarray, rates):
+        self.v0, self.gradient, self._rates = v0, gradient, rates
+
+    @cached_property
+    def rates(self) -> np.ndarray:
+        return self._rates()
+
+    def __call__(self, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.rates, self.v0 + self.gradient @ p
 
 
 def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
@@ -807,26 +823,30 @@ class FingerForces:
     def _kinematics(self, i: int, t: float, y: np.ndarray, shape):
         """Rates of the bird's section (planar: the cut ellipse) or quadric
         (spatial) in finger i's frame, and the bird's surface velocity
-        relative to that frame, by a forward difference over RATE_STEP."""
+        relative to that frame, by a forward difference over RATE_STEP
+        (spatial: as a :class:`SurfaceMotion`)."""
         dt = RATE_STEP
         y2 = y.copy()
         y2[:3] += dt * y[3:]
         base, R = self.frame(i, t)
         base2, R2 = self.frame(i, t + dt)
         body, body2 = self.ellipsoid(y), self.ellipsoid(y2)
-        planar = isinstance(shape, Ellipse)
+        if not isinstance(shape, Ellipse):
+            # p_f -> the point's world position at t, carried with the bird to
+            # t + dt, back in the finger frame then: affine in p_f
+            turn = R2.T @ body2.rotation @ body.rotation.T
+            v0 = (R2.T @ (np.asarray(body2.center) - base2) +
+                  turn @ (base - np.asarray(body.center))) / dt
+            rates = lambda: (body_quadric(body2, base2, R2).params - shape.params) / dt  # noqa: E731
+            return SurfaceMotion(v0, (turn @ R - np.eye(3)) / dt, rates)
+        cut = shape
 
         def surface_velocity(p_f: np.ndarray) -> np.ndarray:
-            p3 = np.concatenate([p_f, [0.0]]) if planar else p_f
+            p3 = np.concatenate([p_f, [0.0]])
             p_w = base + R @ p3
             p_b = body.rotation.T @ (p_w - np.array(body.center))
             p_w2 = np.array(body2.center) + body2.rotation @ p_b
             return (R2.T @ (p_w2 - base2) - p3) / dt
-
-        if not planar:
-            rates = (body_quadric(body2, base2, R2).params - shape.params) / dt
-            return lambda p_f: (rates, surface_velocity(p_f))
-        cut = shape
 
         def kin(p_f: np.ndarray):
             cut2 = body2.cut(base2, R2)
