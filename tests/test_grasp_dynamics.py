@@ -5,10 +5,11 @@ import math
 import numpy as np
 import pytest
 
-from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs
+from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs, Loads
 from design.physics.grasper import Grasper
 from design.solvers.grasp.fingers import FingerForces
-from design.solvers.grasp.integrate import Grasp, IntegratorSettings, _local_error, integrate
+from design.solvers.grasp.integrate import (Grasp, IntegratorSettings, _commit, _local_error,
+                                           integrate)
 
 MEAN = Bird(0.097, 0.066, 0.057, 1.8, 0.00417, "mean")
 FOOTBALL = Bird(0.122, 0.066, 0.066, 0.425, 0.0016, "football")
@@ -205,3 +206,32 @@ def test_bdf4_run_fails_where_a_step_s_local_error_is_too_large(monkeypatch):
     assert not run.ok and run.message.startswith("BDF-4 step from t = 0.1000 s: estimated local")
     assert run.records[-1].t == pytest.approx(0.1)
     assert run.local_error[0] > settings.max_local_error
+
+
+class PressingFromNow:
+    """Fingers that trial evaluations see nothing of (waiting for a first
+    touch) and whose first accepted instant starts a contact pushing the
+    bird up with ``lift`` (N)."""
+
+    states = ()
+
+    def __init__(self, lift: float):
+        self.lift, self.touched, self.pressing = lift, [], False
+
+    def evaluate(self, t, y, commit=False):
+        if commit and not self.pressing:
+            self.pressing, self.touched = True, [0]
+        return Loads(qz=self.lift if self.pressing else 0.0), []
+
+
+def test_a_contact_starting_at_an_accepted_instant_decides_the_belt_mode_again():
+    """A contact that starts at an accepted instant the integrator did not
+    end for it (another event's) was not in the trials that decided the
+    belt mode: where it would make the belt pull the bird down (here a lift
+    of twice the bird's weight), the mode is decided again under it, and
+    the bird leaves the belt, instead of the run failing there."""
+    grasp = Grasp(BirdDynamics(MEAN, Legs(0.0, 0.0), 0.4), Conveyor(0.457),
+                  PressingFromNow(2.0 * MEAN.mass * G))
+    y = np.array([0.0, MEAN.gamma, 0.0, 0.457, 0.0, 0.0])
+    record, mode, _, _, _ = _commit(grasp, 0.1, y, "stick", 0.0)
+    assert mode == record.mode == "air" and record.normal == 0.0

@@ -198,6 +198,8 @@ REVERSAL_DEPTH = 1e-9
 #: least this far (m) inside it, so that the contact solved there starts
 #: (1e-9 to 2e-9 m inside: a few nanoseconds past the crossing)
 TOUCH_DEPTH = 1e-9
+#: the event of a finger's first touch of the bird
+TOUCHES = "a finger touches the bird"
 #: this many events within a nanosecond is chattering: the run stops and says so
 MAX_EVENTS_AT_ONCE = 20
 #: a belt mode's normal force may dip below zero by this fraction of the
@@ -265,7 +267,7 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
     """New (mode, slip sign, state) after an event."""
     if name == "belt slows":
         grasp.start = t
-    if name in ("belt slows", "belt steady"):
+    if name in ("belt slows", "belt steady", TOUCHES):
         return mode, slip_sign, y
     if name == "lift-off":
         return "air", 0.0, y
@@ -347,14 +349,18 @@ def _locate(f, dense, t_old: float, t_new: float, depth: float = 0.0) -> float:
 
 def _commit(grasp: Grasp, t: float, y: np.ndarray, mode: str, slip_sign: float):
     """Accept (t, y): the fingers' friction settles. Where one turned (a new
-    smooth piece) the belt contact is decided again under the new forces
-    before the instant is recorded (the old mode could need N < 0).
-    Returns (record, mode, slip sign, state, whether a friction turned)."""
+    smooth piece), or a contact starting here makes the belt pull (the trials
+    that decided the mode left it out: a first touch not located, at another
+    event), the belt contact is decided again under the new forces before
+    the instant is recorded. Returns (record, mode, slip sign, state,
+    whether a friction turned)."""
     before = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
     record = grasp.record(t, y, mode, slip_sign)
     after = [getattr(st, "tau_mu", None) for st in grasp.fingers.states]
     turned = any(a is not None and b is not None and a != b for a, b in zip(before, after))
-    if turned and mode != "air":
+    pulled = bool(grasp.fingers.touched) and \
+        record.normal < -SUPPORT_TOL * grasp.dyn.bird.mass * G
+    if (turned or pulled) and mode != "air":
         mode, slip_sign, y = decide_mode(grasp, t, y)
         record = grasp.record(t, y, mode, slip_sign)
     return record, mode, slip_sign, y, turned
@@ -396,6 +402,12 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                     hits.append((_locate(f, dense, t_old, t_new), name))
             if hits:
                 tau, name = min(hits)
+                if grasp.fingers.touch_margin(tau, dense(tau)) <= -TOUCH_DEPTH:
+                    # a finger touches the bird before the event: the step ends
+                    # there instead, and the event is found again from it
+                    touch = _locate(grasp.fingers.touch_margin, dense, t_old, tau, TOUCH_DEPTH)
+                    if touch > t_old:
+                        tau, name = touch, TOUCHES
                 if len(traj.events) >= MAX_EVENTS_AT_ONCE and \
                         tau - traj.events[-MAX_EVENTS_AT_ONCE][0] < 1e-9:
                     traj.ok = False
@@ -429,7 +441,7 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
                 # inside already where the step began (its solve there found no
                 # force): the contact starts where the step ends, as found
                 t = t_new if t <= t_old else t
-                traj.events.append((float(t), "a finger touches the bird"))
+                traj.events.append((float(t), TOUCHES))
                 committed = _commit(grasp, t, y_new if t == t_new else dense(t), mode, slip_sign)
                 restart = True
             record, mode, slip_sign, y, _ = committed
