@@ -364,8 +364,7 @@ class SpatialFinger:
         finger frame where the finger may meet the belt, else None."""
         quadric = body_quadric(body, base, R)
         misses = segment_level(quadric, self.solver.finger.length) >= 0.0
-        resting = belt is not None and belt[0].level(
-            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        resting = self._resting(belt)
         if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
             start = self.belted.bird_only(start)         # off the belt: the bird-only solver
         if belt is not None and (resting or isinstance(start, Belted)):
@@ -385,6 +384,12 @@ class SpatialFinger:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
 
+    def _resting(self, belt) -> bool:
+        """Whether the straight finger's tip is below the belt (``belt``: plane
+        and law in the finger frame, or None)."""
+        return belt is not None and belt[0].level(
+            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+
     @staticmethod
     def touching(state) -> bool:
         """Whether a solved state presses on the bird."""
@@ -397,8 +402,7 @@ class SpatialFinger:
         straight finger's, or the finger's on the belt solved in its mode;
         None where that cannot be said without solving the contact."""
         quadric = body_quadric(body, base, R)
-        resting = belt is not None and belt[0].level(
-            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        resting = self._resting(belt)
         if isinstance(start, Belted) and (resting or start.mode in BELT_MODES):
             if belt is None:
                 return None
@@ -626,7 +630,7 @@ class FingerForces:
         memo = self._memo.get(key)
         if not commit and memo is not None:
             return memo[0]
-        waiting = self._waiting()
+        waiting = self._waiting() if commit else set()
         if commit and memo is not None and self._trials_from_committed:
             out, skipped = self._commit_trial(t, y, *memo), ()
         else:
