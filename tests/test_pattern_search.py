@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 
 from design.solvers.optimize import pattern_search, trust_region
-from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
+from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, Scenes, compass
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.trust_region import Evaluated
+from design.solvers.optimize.variables import DesignSpace, Variable
+from tests.design_cases import short_setup
 
 CENTRE = np.array([0.71, 0.23, 0.5, 0.9])
 WEIGHT = np.array([1.0, 3.0, 0.5, 2.0])
@@ -310,3 +312,71 @@ def test_the_search_ends_at_the_first_step_whose_value_is_enough():
     assert len(found.trials) < len(whole.trials)
     at_once = run(d0, enough=lambda v: True)
     assert at_once.trials == [] and np.array_equal(at_once.d, d0)
+
+
+def test_a_design_whose_scene_was_scored_takes_its_score_and_the_search_its_steps(
+        birds, monkeypatch):
+    """A bird whose variable 0 stops acting once variable 1 is at the top of
+    its box (as a belt's start does once its final speed is its speed): a
+    search through :class:`Scenes` takes the same steps, with the same
+    values, to the same design as one that simulates every design; the
+    designs it did not simulate are those whose scene it had, and it
+    simulates that many fewer."""
+    centre = np.array([0.6, 1.0, 0.5, 0.8])
+
+    def acting(d):
+        d = np.array(d, float)
+        if d[1] == 1.0:
+            d[0] = centre[0]
+        return d
+
+    def bird_run(space, d, settings, integrator, cutoff=None):
+        return _stand_in(np.asarray(d, float),
+                         HOLD - float(np.sum(WEIGHT * (acting(d) - centre) ** 2)), FORCE, cutoff)
+    monkeypatch.setattr(pattern_search, "simulate", bird_run)
+    bird = replace(birds, members=birds.members[:1])
+    beats, _ = pattern_search.judges(bird, np.full(1, 13.0),
+                                     SimpleNamespace(objective="hold", min_hold=None))
+    d0 = np.full(4, 0.5)
+
+    def searched(scenes):
+        with Pairs(bird, None, None, 1) as pool:
+            score = scenes(pool.score).score if scenes else pool.score
+            start, = score([d0])
+            return compass(score, d0, start, beats, max_evaluations=60), pool
+    once_scenes = []
+
+    def scenes(score):
+        once_scenes.append(Scenes(score, lambda d: tuple(acting(d))))
+        return once_scenes[0]
+    (every, every_pool), (once, once_pool) = searched(None), searched(scenes)
+    assert [(t.variable, t.units, t.move, t.taken, t.value.hold) for t in every.trials] == \
+        [(t.variable, t.units, t.move, t.taken, t.value.hold) for t in once.trials]
+    assert np.array_equal(every.d, once.d) and once.d[1] == 1.0
+    repeats = once_scenes[0].repeats
+    assert len(repeats) >= 3
+    assert once_pool.simulations == every_pool.simulations - len(repeats)
+    for t in once.trials:
+        if t.d.tobytes() in repeats:
+            assert t.d[1] == 1.0 and np.array_equal(t.value.d, t.d)
+            assert t.value.hold == bird_run(None, t.d, None, None).hold
+
+
+def test_a_belt_that_does_not_slow_has_no_start_or_rate_to_act():
+    """Where the belt's final speed is its speed (to round-off), designs that
+    differ only in its start and rate set up one belt, at its speed all run
+    long, and have one scene key; where it slows, they do not."""
+    setup = short_setup()
+    v = setup.conveyor.speed
+    space = DesignSpace(setup, [Variable("conveyor.start_time", 0.0, 1.4, 0.0),
+                                Variable("conveyor.final_speed", v / 2, v, v),
+                                Variable("conveyor.rate", 0.5, 3.0, 2.0)])
+    steady = [np.array([0.2, 1.0, 0.3]), np.array([0.7, 1 - 1e-14, 0.9])]
+    a, b = (space.setup(d).conveyor for d in steady)
+    assert a == b and space.scene_key(steady[0]) == space.scene_key(steady[1])
+    assert all(a.velocity(t, a.start_time) == (v, 0.0) for t in (0.0, 0.3, 1.0, 1.5))
+    slowing = [np.array([0.2, 0.99, 0.3]), np.array([0.7, 0.99, 0.3]),
+               np.array([0.2, 0.99, 0.9])]
+    assert len({space.scene_key(d) for d in slowing}) == 3
+    c = space.setup(slowing[1]).conveyor
+    assert c.velocity(1.3, c.start_time)[0] < v

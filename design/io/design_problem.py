@@ -31,7 +31,7 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # method: trust-region (default: Ipopt moves the design)
                                # or pattern (the simulator's lattice search, the same
                                # answer under round-off: pattern_search.py); pattern's
-                               # max_simulations: designs simulated (150)
+                               # max_simulations: designs evaluated (150)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.speed|start_time|rate|final_speed``,

@@ -5,7 +5,7 @@ a decision, the next two. Where one of them ends early (a candidate ruled
 out) its core would wait for the other. Here each simulation is a forked
 process of its own, at most one per core at a time, and while the ones
 asked for run, a free core starts one the caller will probably ask for
-next (the next poll's, if this one moves nothing). A simulation run ahead
+next (the next polls', if this one moves nothing). A simulation run ahead
 is the computation it would be when asked for (the same job: design, bird
 and rival), so what the caller gets, and decides, does not depend on
 whether it ran ahead; one no longer wanted is killed.

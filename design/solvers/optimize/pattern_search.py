@@ -24,7 +24,10 @@ comparison of two simulated holds or of a peak with the cap flips:
 * the search's simulations are the loop's (rtol 1e-6, steps no longer than
   the optimiser's grid): the cap is decided on the peak force, and a looser
   tolerance can step over a force transient of a few ms at a contact;
-* a budget of simulations ends the search, as deterministically;
+* a budget of designs evaluated ends the search, as deterministically;
+* a design whose scene is one already simulated (a belt that does not
+  slow, polled at another start or rate) takes that one's score without a
+  simulation: it is the same run;
 * a candidate is ruled out as soon as one of its runs shows that it cannot
   beat the incumbent (one bird, or a population's worst hold, once the
   incumbent keeps every limit): a finger over its limit, or a hold no
@@ -42,8 +45,8 @@ comparison of two simulated holds or of a peak with the cap flips:
 * the simulations of a poll or an extension (two designs' birds, or one
   design's) are handed out one bird at a time to two forked processes
   where there are two cores, and a core they leave free starts on the next
-  poll's first runs, as they would be asked for if this evaluation moves
-  nothing (design/solvers/optimize/ahead.py): the same simulations as one
+  three polls' runs, as they would be asked for if this evaluation moves
+  nothing, as most do not (design/solvers/optimize/ahead.py): the same simulations as one
   process would run, and the same record.
 
 The search's claim for its design is its own simulation of it; the
@@ -77,6 +80,8 @@ from design.solvers.optimize.variables import DesignSpace
 
 #: the lattice's unit and the first step, in lattice units (scaled variables)
 LATTICE, FIRST_STEP = 1 / 64, 8
+#: the polls whose points may run ahead on a free core
+AHEAD_POLLS = 3
 #: a move must lengthen the hold by more than this (s)
 HOLD_BAND = 1e-4
 #: the default budget of simulations
@@ -143,7 +148,7 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     def evaluate(tried: list[tuple], i: int, move: str) -> list:
         """The values of ``tried``'s points ((k, units) pairs), the unseen ones
         evaluated together, as many as the budget allows (None beyond it);
-        the next poll's points, should this evaluation move nothing, go
+        the next polls' points, should this evaluation move nothing, go
         with them as the ones probably asked for next."""
         new = unseen(p for p, _ in tried)[:max(0, max_evaluations - len(seen))]
         if new:
@@ -169,18 +174,21 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
         return t != k and allowed(point(t))
 
     def upcoming(i: int) -> list[tuple]:
-        """The unseen points of the next poll that has any after variable
-        i's, should the search stay where it is (a sweep without a move
-        halves the step)."""
-        n = len(d0)
+        """The unseen points of the next :data:`AHEAD_POLLS` polls that have
+        any after variable i's, should the search stay where it is (a sweep
+        without a move halves the step)."""
+        n, out, polls = len(d0), [], 0
         for j in range(i + 1, i + 1 + n):
             size = units if j < n or any_move else units // 2
             if size < 1:
-                return []
+                break
             new = unseen(t for u in (size, -size) if valid(t := step(k, j % n, u), k))
             if new:
-                return new
-        return []
+                out += new
+                polls += 1
+                if polls == AHEAD_POLLS:
+                    break
+        return out
 
     k, units, cut, any_move = (0,) * len(d0), FIRST_STEP, False, False
 
@@ -243,7 +251,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     point that breaks a design rule the baseline keeps is not tried. The
     points evaluated together are simulated by ``workers`` processes (by
     default one per core, at most two: :class:`Pairs`); the answer does not
-    depend on how many. ``settings.max_simulations`` designs simulated end
+    depend on how many. ``settings.max_simulations`` designs evaluated end
     the search."""
     t0 = time.perf_counter()
     max_simulations = settings.max_simulations
@@ -254,17 +262,18 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     beats, rivals = judges(population, caps, settings)
     pool = Pairs(population, settings, settings.simulator, workers, rivals)
 
-    def simulate_all(designs, incumbent=None, ahead=()):
+    def simulated(designs, incumbent=None, ahead=()):
         with profile.phase(SIMULATIONS):
             return pool.score(designs, incumbent, ahead)
+    scenes = Scenes(simulated, population.space.scene_key)
 
     d0 = population.space.scale(population.space.base_values)
     allowed = allowed_by(population.space, rules)
-    baseline, = simulate_all([d0])
+    baseline, = scenes.score([d0])
     check_baseline(population, baseline)
     origin, first = d0, baseline
     if start is not None:
-        started, = simulate_all([np.asarray(start, float)])
+        started, = scenes.score([np.asarray(start, float)])
         if not (anchor and beats(baseline, started)):
             origin, first = started.d, started
     names = [v.name for v in population.space.variables]
@@ -280,7 +289,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             f"peak {trial.value.peak:.2f} N ({count} simulations)")
 
     with pool:
-        found = compass(simulate_all, origin, first, beats, allowed, max_simulations, moved)
+        found = compass(scenes.score, origin, first, beats, allowed, max_simulations, moved)
     out = Outcome(found.value, baseline, caps, profile=profile)
     source = (f"the pattern search's simulation (rtol {settings.simulator.rtol:g}, steps up "
               f"to the grid's)")
@@ -291,6 +300,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         "variable": names[t.variable], "direction": int(np.sign(t.units)),
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
+        "same_scene": scenes.repeated(t.d),
         **({} if len(caps) == 1 else {
             "simulated_hold_times_s": per_bird(population, t.value, "hold"),
             "simulated_peak_forces_N": per_bird(population, t.value, "peak")}),
@@ -302,7 +312,8 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         for n, t in enumerate(found.trials)]
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
-                  "simulations": len(found.trials) + 1 + (start is not None),
+                  "simulations": len(found.trials) + 1 + (start is not None) - len(scenes.repeats),
+                  "same_scene": len(scenes.repeats),
                   "bird_simulations": pool.simulations,
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes, "runs_ahead": pool.ran_ahead,
@@ -311,6 +322,39 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     out.trials = found.trials
     out.wall_time = time.perf_counter() - t0
     return out
+
+
+class Scenes:
+    """Designs scored by ``score(designs, incumbent, ahead)`` once per scene:
+    a design whose ``key`` (:meth:`~DesignSpace.scene_key`) is that of one
+    scored before, or earlier in the same call, takes that one's score
+    without a simulation (the same run)."""
+
+    def __init__(self, score, key):
+        self._score, self.key = score, key
+        self.scored: dict[tuple, Scored] = {}
+        #: the designs (their bytes) that took another's score
+        self.repeats: set[bytes] = set()
+
+    def score(self, designs, incumbent=None, ahead=()) -> list[Scored]:
+        keys = [self.key(d) for d in designs]
+        new: dict[tuple, np.ndarray] = {}
+        for k, d in zip(keys, designs):
+            if k in self.scored or k in new:
+                self.repeats.add(np.asarray(d, float).tobytes())
+            else:
+                new[k] = d
+        later: dict[tuple, np.ndarray] = {}
+        for d in ahead:
+            later.setdefault(self.key(d), d)
+        ahead = [d for k, d in later.items() if k not in self.scored and k not in new]
+        if new:
+            self.scored.update(zip(new, self._score(list(new.values()), incumbent, ahead)))
+        return [replace(self.scored[k], d=np.asarray(d, float)) for k, d in zip(keys, designs)]
+
+    def repeated(self, d) -> bool:
+        """Did design ``d`` take another's score?"""
+        return np.asarray(d, float).tobytes() in self.repeats
 
 
 def judges(population: Population, caps: np.ndarray, settings: LoopSettings):

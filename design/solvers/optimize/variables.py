@@ -167,9 +167,33 @@ class DesignSpace:
         """The grasp at scaled variables d, for the simulator."""
         return apply(self.baseline, self.values(np.asarray(d, float)))
 
+    def scene_key(self, d: np.ndarray) -> tuple:
+        """The parameters that act on the grasp at scaled d (:func:`acting`):
+        two designs with the same key simulate the same scene."""
+        return tuple(sorted(acting(self.values(np.asarray(d, float)), self.baseline).items()))
+
+
+#: a final speed within this fraction of the belt's speed is its speed
+SAME_SPEED = 1e-12
+
+
+def acting(values: dict, setup: GraspSetup) -> dict:
+    """``values`` (SI) as they act on ``setup``'s grasp: a belt that does not
+    slow stays at its (new) speed, and one whose final speed is its speed
+    has no start or rate to act (start 0 s, ``setup``'s rate)."""
+    out, c = dict(values), setup.conveyor
+    speed = out["conveyor.speed"]
+    if out["conveyor.final_speed"] == c.speed == c.final_speed:
+        out["conveyor.final_speed"] = speed
+    if abs(out["conveyor.final_speed"] - speed) <= SAME_SPEED * speed:
+        out.update({"conveyor.final_speed": speed, "conveyor.start_time": 0.0,
+                    "conveyor.rate": c.rate})
+    return out
+
 
 def apply(setup: GraspSetup, values: dict) -> GraspSetup:
     """The grasp with these parameter values (SI)."""
+    values = acting(values, setup)
     fingers = []
     for gf in setup.grasper.fingers:
         key = f"fingers.{gf.design_name}."
@@ -182,10 +206,8 @@ def apply(setup: GraspSetup, values: dict) -> GraspSetup:
     grasper = replace(setup.grasper, fingers=tuple(fingers), spacing=values["spacing"])
     c = setup.conveyor
     speed, drum_speed = values["conveyor.speed"], values["drum_speed"]
-    final = values["conveyor.final_speed"]
-    if final == c.speed == c.final_speed:                   # a belt that does not slow
-        final = speed
-    conveyor = Conveyor(speed, final, values["conveyor.rate"], values["conveyor.start_time"])
+    conveyor = Conveyor(speed, values["conveyor.final_speed"], values["conveyor.rate"],
+                        values["conveyor.start_time"])
     out = replace(setup, grasper=grasper, conveyor=conveyor, drum_speed=drum_speed)
     if (speed, drum_speed) == (c.speed, setup.drum_speed):
         return out
