@@ -46,8 +46,8 @@ comparison of two simulated holds or of a peak with the cap flips:
   design's) are handed out one bird at a time to two forked processes
   where there are two cores, and a core they leave free starts on the next
   three polls' runs, as they would be asked for if this evaluation moves
-  nothing, as most do not (design/solvers/optimize/ahead.py): the same simulations as one
-  process would run, and the same record.
+  nothing, as most do not (design/solvers/optimize/ahead.py): the same
+  simulations as one process would run, and the same record.
 
 The search's claim for its design is its own simulation of it; the
 verification simulates it again at 4x finer resolution (steps a quarter of
