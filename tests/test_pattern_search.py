@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from design.solvers.optimize import pattern_search, trust_region
-from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, Scenes, compass
+from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
+from design.solvers.optimize.scenes import Scenes
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.trust_region import Evaluated
 from design.solvers.optimize.variables import DesignSpace, Variable

@@ -153,9 +153,10 @@ def search_table(page: Page, solver: dict) -> None:
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
               f"with every finger under the cap; {s['simulations']} designs simulated, the "
               f"baseline's included"
-              + (f", and {s['same_scene']} whose scene was one simulated before (a belt "
-                 "that does not slow has no start or rate to act), scored as that one"
-                 if s.get("same_scene") else "")
+              + (f", and {s['same_runs']} whose run would be one simulated before, scored "
+                 "as that one (a belt that does not slow has no start or rate to act; a "
+                 "finger the run never reached adds nothing to it)"
+                 if s.get("same_runs") else "")
               + f", on a budget of {s['max_simulations']} designs from the start"
               + ("" if s["lattice_optimum"] else ", the budget ending the search") + "."
               + ((f" {s['bird_simulations']} bird simulations: a candidate's birds are "
@@ -175,7 +176,7 @@ def search_table(page: Page, solver: dict) -> None:
                  "simulated hold (s)": None if h.get("stopped") else h["simulated_hold_time_s"],
                  "simulated peak (N)": None if h.get("stopped") else h["simulated_peak_force_N"],
                  **({"ruled out by": ruled_out(h)} if ruled else {}),
-                 **({"scene simulated before": h["same_scene"]} if s.get("same_scene")
+                 **({"run simulated before": h["same_run"]} if s.get("same_runs")
                     else {}),
                  "taken": h["accepted"]} for h in solver["history"]],
                "Pattern search", "history-table")

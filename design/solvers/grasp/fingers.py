@@ -79,6 +79,9 @@ FRICTION_SPEED = 0.02
 #: finger model decides by its own test (the planar one from its section,
 #: whose level differs from the ellipsoid's by rounding)
 MISSES = 1e-9
+#: :func:`clear_at`'s margins over MISSES (level) and over the belt (tip
+#: height, m): far above any round-off of the two ways of computing them
+CLEAR_LEVEL, CLEAR_HEIGHT = 1e-6, 1e-6
 #: the friction-reversal margin (m/s) reported where no finger's friction can reverse
 NO_REVERSAL = 1.0
 #: a planar finger meets the belt only where its bending plane is at least this
@@ -146,6 +149,39 @@ def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end
         near = np.min(np.linalg.norm(gap, axis=2), axis=1) <= reach
         out.append(_windows(near, times, dt))
     return out
+
+
+def clear_at(grasper: Grasper, bird: Bird, speed: float, fingers: list[int],
+             probes: np.ndarray) -> bool:
+    """Whether the straight fingers ``fingers`` (indices) stay clear of the
+    bird and above the belt at every probe (t, X, Z, pitch) (s, m, m, rad;
+    the bird's centre at (X, 0, Z)), with a margin for round-off: where
+    :meth:`FingerForces.reaching` looks, it leaves them out."""
+    if len(probes) == 0 or not fingers:
+        return True
+    t, x, z, pitch = np.asarray(probes, float).T
+    drum = grasper.drum(speed)
+    turns = drum.turning(t)
+    centre = np.stack([x, np.zeros_like(x), z], axis=1)
+    c, s = np.cos(pitch), np.sin(pitch)
+    scale = np.array([1 / bird.eta, 1 / bird.lam, 1 / bird.gamma])
+
+    def body(v):
+        """World vectors (n, 3) in body coordinates (rot_y(pitch) transposed), scaled."""
+        return scale * np.stack([c * v[:, 0] - s * v[:, 2], v[:, 1], s * v[:, 0] + c * v[:, 2]],
+                                axis=1)
+    for i in fingers:
+        gf = grasper.fingers[i]
+        base0, R0 = drum.frame(gf.mount, 0.0)
+        base = drum.origin + turns @ (base0 - drum.origin)
+        axis = turns @ R0[:, 0]
+        p, e = body(base - centre), body(axis)
+        along = np.clip(-np.sum(p * e, axis=1) / np.sum(e * e, axis=1), 0.0, gf.finger.length)
+        level = np.sum((p + along[:, None] * e) ** 2, axis=1) - 1.0
+        tip_z = base[:, 2] + axis[:, 2] * gf.finger.length
+        if np.any(level <= CLEAR_LEVEL) or np.any(tip_z <= CLEAR_HEIGHT):
+            return False
+    return True
 
 
 def _windows(near: np.ndarray, times: np.ndarray, dt: float) -> list[tuple[float, float]]:
@@ -526,6 +562,11 @@ class FingerForces:
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved
         self.skipped = 0           # finger evaluations the reach windows saved
+        #: every instant :meth:`reaching` looked at, (t, X, Z, pitch) (s, m, m,
+        #: rad), and the fingers it ever found reaching: a finger clear at
+        #: each of them adds nothing to the run (:func:`clear_at`)
+        self.probes: list[tuple[float, float, float, float]] = []
+        self.reached: set[int] = set()
         #: (the run's most belt-continuation rootfinder calls, the budget per
         #: simulated second) or None: no budget (:class:`OverBudget`)
         self.budget: tuple[float, float] | None = None
@@ -575,6 +616,7 @@ class FingerForces:
         straight tip below it), which the bird may meet bent: every
         evaluation solves the same ones, so that a trial sees what the
         accepted instant will."""
+        self.probes.append((t, body.center[0], body.center[2], body.pitch))
         if self._window_ends is None:
             inside = np.arange(len(self.models))
         else:
@@ -590,7 +632,9 @@ class FingerForces:
         below = tips[:, 2] < 0
         resting = [i for i, tip in zip(inside[below], tips[below])
                    if self.belt.touches(self.grasper.fingers[i].design_name, tip[1])]
-        return out | set(int(i) for i in resting)
+        out |= set(int(i) for i in resting)
+        self.reached |= out
+        return out
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the

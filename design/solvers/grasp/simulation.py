@@ -56,6 +56,10 @@ class GraspRun:
     contact_solves: int
     skipped: int
     setup_time: float
+    #: the instants the run looked for fingers reaching the bird, (t, X, Z,
+    #: pitch) (n, 4), and the fingers it found reaching (FingerForces.probes)
+    probes: np.ndarray | None = None
+    reached: frozenset = frozenset()
 
     @cached_property
     def summary(self) -> dict:
@@ -92,7 +96,8 @@ def simulate_grasp(setup: GraspSetup, integrator: IntegratorSettings = Integrato
     y0 = np.array([setup.start_x, b.gamma, 0.0, conv.speed, 0.0, 0.0])
     setup_time = time.perf_counter() - t0
     traj = integrate(grasp, y0, setup.duration, integrator, progress, watch)
-    return GraspRun(setup, traj, windows, fingers.solves, fingers.skipped, setup_time)
+    return GraspRun(setup, traj, windows, fingers.solves, fingers.skipped, setup_time,
+                    np.array(fingers.probes, float).reshape(-1, 4), frozenset(fingers.reached))
 
 
 def setup_reach_windows(setup: GraspSetup) -> list[list[tuple[float, float]]]:

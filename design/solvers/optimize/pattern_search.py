@@ -25,9 +25,11 @@ comparison of two simulated holds or of a peak with the cap flips:
   the optimiser's grid): the cap is decided on the peak force, and a looser
   tolerance can step over a force transient of a few ms at a contact;
 * a budget of designs evaluated ends the search, as deterministically;
-* a design whose scene is one already simulated (a belt that does not
-  slow, polled at another start or rate) takes that one's score without a
-  simulation: it is the same run;
+* a design whose run would be one already simulated takes that one's
+  score without a simulation (design/solvers/optimize/scenes.py): one of
+  the same scene (a belt that does not slow, polled at another start or
+  rate), or one that differs from the current design only in fingers its
+  run never reached, which stay clear of the bird where it puts them;
 * a candidate is ruled out as soon as one of its runs shows that it cannot
   beat the incumbent (one bird, or a population's worst hold, once the
   incumbent keeps every limit): a finger over its limit, or a hold no
@@ -63,6 +65,7 @@ import copy
 import resource
 import time
 from dataclasses import dataclass, replace
+from functools import partial
 
 import numpy as np
 
@@ -72,6 +75,7 @@ from design.solvers.optimize.forked import processes
 from design.solvers.optimize.line import faster, rate_of
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
+from design.solvers.optimize.scenes import Scenes, same_run
 from design.solvers.optimize.transcription import Rules, rule_margins
 from design.solvers.optimize.trust_region import (Evaluated, LoopSettings, Outcome, Scored,
                                                    alone, better, caps_text, caps_value,
@@ -265,7 +269,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     def simulated(designs, incumbent=None, ahead=()):
         with profile.phase(SIMULATIONS):
             return pool.score(designs, incumbent, ahead)
-    scenes = Scenes(simulated, population.space.scene_key)
+    scenes = Scenes(simulated, population.space.scene_key, partial(same_run, population))
 
     d0 = population.space.scale(population.space.base_values)
     allowed = allowed_by(population.space, rules)
@@ -300,7 +304,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         "variable": names[t.variable], "direction": int(np.sign(t.units)),
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
-        "same_scene": scenes.repeated(t.d),
+        "same_run": scenes.repeated(t.d),
         **({} if len(caps) == 1 else {
             "simulated_hold_times_s": per_bird(population, t.value, "hold"),
             "simulated_peak_forces_N": per_bird(population, t.value, "peak")}),
@@ -313,7 +317,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
                   "simulations": len(found.trials) + 1 + (start is not None) - len(scenes.repeats),
-                  "same_scene": len(scenes.repeats),
+                  "same_runs": len(scenes.repeats),
                   "bird_simulations": pool.simulations,
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes, "runs_ahead": pool.ran_ahead,
@@ -322,39 +326,6 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     out.trials = found.trials
     out.wall_time = time.perf_counter() - t0
     return out
-
-
-class Scenes:
-    """Designs scored by ``score(designs, incumbent, ahead)`` once per scene:
-    a design whose ``key`` (:meth:`~DesignSpace.scene_key`) is that of one
-    scored before, or earlier in the same call, takes that one's score
-    without a simulation (the same run)."""
-
-    def __init__(self, score, key):
-        self._score, self.key = score, key
-        self.scored: dict[tuple, Scored] = {}
-        #: the designs (their bytes) that took another's score
-        self.repeats: set[bytes] = set()
-
-    def score(self, designs, incumbent=None, ahead=()) -> list[Scored]:
-        keys = [self.key(d) for d in designs]
-        new: dict[tuple, np.ndarray] = {}
-        for k, d in zip(keys, designs):
-            if k in self.scored or k in new:
-                self.repeats.add(np.asarray(d, float).tobytes())
-            else:
-                new[k] = d
-        later: dict[tuple, np.ndarray] = {}
-        for d in ahead:
-            later.setdefault(self.key(d), d)
-        ahead = [d for k, d in later.items() if k not in self.scored and k not in new]
-        if new:
-            self.scored.update(zip(new, self._score(list(new.values()), incumbent, ahead)))
-        return [replace(self.scored[k], d=np.asarray(d, float)) for k, d in zip(keys, designs)]
-
-    def repeated(self, d) -> bool:
-        """Did design ``d`` take another's score?"""
-        return np.asarray(d, float).tobytes() in self.repeats
 
 
 def judges(population: Population, caps: np.ndarray, settings: LoopSettings):

@@ -167,6 +167,24 @@ class DesignSpace:
         """The grasp at scaled variables d, for the simulator."""
         return apply(self.baseline, self.values(np.asarray(d, float)))
 
+    def finger_change(self, a: np.ndarray, b: np.ndarray) -> tuple[set[int], set[int]] | None:
+        """Where scaled designs a and b differ only in fingers' parameters: the
+        fingers (indices) moved or resized, and those whose group's stiffness
+        differs; None where another parameter differs."""
+        va, vb = self.values(np.asarray(a, float)), self.values(np.asarray(b, float))
+        fingers = self.baseline.grasper.fingers
+        moved, stiffened = set(), set()
+        for name in (n for n in va if va[n] != vb[n]):
+            kind, _, rest = name.partition(".")
+            owner, _, field = rest.rpartition(".")
+            if kind == "fingers" and field in FINGER_FIELDS:
+                moved |= {i for i, gf in enumerate(fingers) if gf.design_name == owner}
+            elif kind == "groups" and field in GROUP_FIELDS:
+                stiffened |= {i for i, gf in enumerate(fingers) if gf.group == owner}
+            else:
+                return None
+        return moved, stiffened
+
     def scene_key(self, d: np.ndarray) -> tuple:
         """The parameters that act on the grasp at scaled d (:func:`acting`):
         two designs with the same key simulate the same scene."""

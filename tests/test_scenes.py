@@ -1,0 +1,78 @@
+"""A search's design whose run would be one already simulated
+(design/solvers/optimize/scenes.py): a design that moves only fingers the
+current design's run never reached has that run, record for record, and
+the search scores it so without simulating it."""
+
+import numpy as np
+import pytest
+
+from design.solvers.grasp.fingers import clear_at
+from design.solvers.grasp.simulation import SPATIAL_NODES, simulate_grasp
+from design.solvers.optimize.pattern_search import LATTICE
+from design.solvers.optimize.population import Population
+from design.solvers.optimize.scenes import Scenes, same_run
+from design.solvers.optimize.trust_region import LOOP_SIMULATOR, Evaluated, Scored
+from tests.test_spatial_nlp import placed_space
+
+
+@pytest.fixture(scope="module")
+def placed():
+    """The placed mean bird's first 0.1 s with the spatial finger at the
+    search's tolerance (0.5 s CPU): fingers 1a, 2a, 4a and 5a reach it
+    (5a's tip on the belt); the fingers 3 stay clear."""
+    space = placed_space(0.1)
+    d0 = space.scale(space.base_values)
+    run = simulate_grasp(space.setup(d0), LOOP_SIMULATOR, SPATIAL_NODES)
+    population = Population.of(space)
+    return space, population, Scored(d0, [Evaluated(d0, run)], population)
+
+
+def moved(space, d, name: str, units: int) -> np.ndarray:
+    """``d`` with variable ``name`` moved by ``units`` lattice units."""
+    out = np.array(d, float)
+    out[[v.name for v in space.variables].index(name)] += units * LATTICE
+    return out
+
+
+def test_a_finger_clear_at_every_instant_the_run_looked_was_never_reached(placed):
+    """:func:`clear_at` agrees with the run's own test of which fingers to
+    solve: no finger it finds clear at all the run's probes was ever
+    reached, and it finds some clear (the test is not empty)."""
+    space, _, reference = placed
+    run, setup = reference.run, space.baseline
+    names = [gf.name for gf in setup.grasper.fingers]
+    clear = {i for i in range(len(names))
+             if clear_at(setup.grasper, setup.bird, setup.drum_speed, [i], run.probes)}
+    assert {names[i] for i in run.reached} == {"1a", "2a", "4a", "5a"}
+    assert not clear & run.reached
+    assert {"3a", "3b", "3c"} <= {names[i] for i in clear}
+    assert len(run.probes) > 3 * len(run.trajectory.records)
+
+
+def test_a_design_that_moves_only_unreached_fingers_has_the_same_run(placed):
+    """Fingers 3 turned by one lattice unit: the design's own simulation is
+    the reference's record for record (times and states to the bit), and
+    :class:`Scenes` scores it as the reference without simulating it.
+    Finger 4 turned (4a pressed the bird) or the lower group stiffened
+    (5a rested on the belt): not the same run."""
+    space, population, reference = placed
+    d = moved(space, reference.d, "fingers.3.angle", 1)
+    assert same_run(population, d, reference)
+    own = simulate_grasp(space.setup(d), LOOP_SIMULATOR, SPATIAL_NODES)
+    ref = reference.run
+    assert [r.t for r in own.trajectory.records] == [r.t for r in ref.trajectory.records]
+    assert all(np.array_equal(a.y, b.y) for a, b in zip(own.trajectory.records,
+                                                        ref.trajectory.records))
+    assert own.summary["max_force_per_finger_N"] == ref.summary["max_force_per_finger_N"]
+    assert own.summary["hold_windows"] == ref.summary["hold_windows"]
+
+    simulated = []
+    scenes = Scenes(lambda designs, incumbent, ahead: simulated.extend(designs),
+                    space.scene_key, lambda d, incumbent: same_run(population, d, incumbent))
+    scored, = scenes.score([d], reference)
+    assert simulated == [] and scenes.repeated(d)
+    assert scored.hold == reference.hold and np.array_equal(scored.d, d)
+    for other in (moved(space, reference.d, "fingers.4.angle", 1),
+                  moved(space, reference.d, "groups.lower.stiffness_scale", 1),
+                  moved(space, reference.d, "conveyor.rate", 1)):
+        assert not same_run(population, other, reference)
