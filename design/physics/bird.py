@@ -85,7 +85,7 @@ class Conveyor:
 
     def velocity(self, t: float, start: float | None) -> tuple[float, float]:
         """Speed (m/s) and acceleration (m/s²) at t, given the start time."""
-        if not self.decelerates or start is None:
+        if not self.decelerates or start is None or self.final_speed == self.speed:
             return self.speed, 0.0
         v, v_dot, _ = belt_motion(t, self.speed, self.final_speed, self.rate, start)
         return v, v_dot

@@ -187,13 +187,13 @@ class Chord:
               max_iter: int) -> np.ndarray | None:
         """The root from z0 with max |R| ≤ ``tolerance``, or None."""
         z = np.array(z0, float)
-        for _ in range(max_iter + 1):
-            r = self._residual(z, q)[0].ravel()
-            size = np.max(np.abs(r))
-            if size <= tolerance:
-                return z
-            if not np.isfinite(size):
-                return None
-            with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None above
+        with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None below
+            for _ in range(max_iter + 1):
+                r = self._residual(z, q)[0].ravel()
+                size = np.max(np.abs(r))
+                if size <= tolerance:
+                    return z
+                if not np.isfinite(size):
+                    return None
                 z -= inverse @ r
         return None

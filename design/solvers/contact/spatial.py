@@ -179,9 +179,8 @@ def deepest_along(quadric: Quadric, length: float) -> float:
 
 def segment_level(quadric: Quadric, length: float) -> float:
     """min over the straight finger (0 ≤ x ≤ l on the x axis) of the level
-    function: < 0 when it passes through the object."""
-    xs = np.array([0.0, length, deepest_along(quadric, length)])
-    return float(np.min(quadric.level(np.stack([xs, np.zeros(3), np.zeros(3)]))))
+    function, at its deepest point: < 0 when it passes through the object."""
+    return float(quadric.level(np.array([[deepest_along(quadric, length)], [0.0], [0.0]]))[0])
 
 
 def grazing_shift(quadric: Quadric, length: float, samples: int = 72

@@ -111,12 +111,18 @@ class FingerState:
 
     @property
     def magnitude(self) -> float:
-        return float(np.linalg.norm(self.force))
+        """|force| (N); 0 without a contact point (the force is then zero)."""
+        return 0.0 if self.point is None else float(np.linalg.norm(self.force))
 
     @property
     def belt_force(self) -> float:
         """The finger's normal force on the belt (N; 0 off the belt)."""
         return float(getattr(self.solution, "belt_normal_force", 0.0))
+
+
+#: every finger out of reach, at every evaluation: one state, read-only
+OUT_OF_REACH = FingerState()
+OUT_OF_REACH.force.setflags(write=False)
 
 
 def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end: float,
@@ -749,7 +755,7 @@ class FingerForces:
             self.trials[i] = None
             if commit:
                 self.states[i] = None
-            return FingerState()
+            return OUT_OF_REACH
         self.solves += 1
         state = self._kept(i, t, y, body, force, p_w, sol, cont, commit)
         if p_w is not None:
