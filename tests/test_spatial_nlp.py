@@ -16,7 +16,7 @@ import pytest
 from design.io.scene import load_scene
 from design.run.solve import design_space
 from design.solvers.contact.spatial import SpatialState
-from design.solvers.grasp.fingers import SpatialFinger
+from design.solvers.grasp.fingers import FingerForces, SpatialFinger
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import SPATIAL_NODES, simulate_grasp
 from design.solvers.optimize.schedule import STAGES, schedule_of
@@ -218,10 +218,11 @@ def test_the_nlp_finger_on_the_belt_is_the_simulators(finger_5a_on_the_belt):
     assert np.allclose(np.asarray(out).ravel(), expected, rtol=1e-9, atol=1e-9 * abs(f).max())
 
 
-def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget():
+def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget(monkeypatch):
     """The count of the belt continuations' rootfinder calls is the run's own
     (the same on every machine): a budget below it stops the run, not ok,
-    saying where and why, as soon as the count passes it; the unlimited run
+    saying where and why, as soon as the count passes it (at the evaluation
+    that passes it, an accepted instant's as a trial's); the unlimited run
     goes to its end."""
     setup, run = prefetch.result(ON_THE_BELT, on_the_belt)
     assert run.summary["ok"]
@@ -235,11 +236,25 @@ def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget():
     # that makes the third, not at the next accepted instant: at the end of
     # a step that a finger's first touch inside it then shortens, not one of
     # the instants the whole run accepts
+    evaluations = []
+    evaluate = FingerForces.evaluate
+
+    def counted(self, t, y, commit=False):
+        try:
+            return evaluate(self, t, y, commit)
+        finally:
+            evaluations.append((t, commit, self.newton_solves))
+    monkeypatch.setattr(FingerForces, "evaluate", counted)
+    simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)          # the whole run's evaluations
     two = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=2 / setup.duration),
                          SPATIAL_NODES)
     found = re.search(r"stopped at t = ([\d.]+) s: .* rootfinder (\d+) times",
                       two.summary["message"])
     assert not two.summary["ok"] and int(found.group(2)) == 3
+    # the third call is an accepted instant's, and the next trial is elsewhere
+    t_passed, at_commit, _ = next(e for e in evaluations if e[2] > 2)
+    next_trial = next(t for t, commit, n in evaluations if n > 2 and not commit)
+    assert at_commit and found.group(1) == f"{t_passed:.4f}" != f"{next_trial:.4f}"
     accepted = np.array([r.t for r in run.trajectory.records])
     assert 0.0 < float(found.group(1)) < run.trajectory.records[-1].t
     assert np.min(np.abs(accepted - float(found.group(1)))) > 5e-5
