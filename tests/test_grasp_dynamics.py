@@ -8,8 +8,8 @@ import pytest
 from design.physics.bird import G, Bird, BirdDynamics, Conveyor, Legs, Loads
 from design.physics.grasper import Grasper
 from design.solvers.grasp.fingers import FingerForces
-from design.solvers.grasp.integrate import (Grasp, IntegratorSettings, _commit, _local_error,
-                                           integrate)
+from design.solvers.grasp.integrate import (GAP_TOL, Grasp, IntegratorSettings, _after_event,
+                                           _commit, _local_error, decide_mode, integrate)
 
 MEAN = Bird(0.097, 0.066, 0.057, 1.8, 0.00417, "mean")
 FOOTBALL = Bird(0.122, 0.066, 0.066, 0.425, 0.0016, "football")
@@ -100,6 +100,19 @@ def test_belt_braking_harder_than_friction_makes_the_bird_slip():
     assert belt_steady < t_stick < 0.1 + (0.457 - 0.1) / (0.4 * G)
     at_stick = min(traj.records, key=lambda r: abs(r.t - t_stick))
     assert grasp.dyn.slip(at_stick.y, at_stick.belt_speed) == pytest.approx(0.0, abs=1e-9)
+
+
+def test_a_bird_its_mode_holds_on_the_belt_is_not_lifted_by_the_drift_of_that_constraint():
+    """A belt mode integrates Z = D(θ), which drifts: a slipping bird 2 nm
+    above the belt (twice GAP_TOL) at its stick event sticks, settled onto
+    the belt (a lift is the lift-off event, N crossing zero); a bird as far
+    above it, not held there, is in the air."""
+    grasp = bare()
+    y = np.array([0.0, MEAN.gamma + 2 * GAP_TOL, 0.0, 0.457, 0.0, 0.0])
+    assert grasp.dyn.gap(y) > GAP_TOL
+    mode, _, settled = _after_event(grasp, "stick", 0.0, y, "slip", 1.0)
+    assert mode == "stick" and grasp.dyn.gap(settled) == pytest.approx(0.0, abs=1e-15)
+    assert decide_mode(grasp, 0.0, y)[0] == "air"
 
 
 def test_legs_pull_a_lifted_bird_back():

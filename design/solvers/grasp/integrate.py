@@ -207,17 +207,21 @@ MAX_EVENTS_AT_ONCE = 20
 SUPPORT_TOL = 1e-6
 
 
-def decide_mode(grasp: Grasp, t: float, y: np.ndarray, landing: bool = False):
+def decide_mode(grasp: Grasp, t: float, y: np.ndarray, landing: bool = False,
+                on_belt: bool = False):
     """(mode, slip sign, state) consistent with (t, y).
 
-    Off the belt: air. On it: air again if the free motion would lift the
-    lowest point anyway; else stick if A rolls with the belt and the friction
-    it needs is inside the cone, else slip in the direction A moves (or, from
-    rest, the direction the friction cannot hold). If sliding would need a
-    negative normal force (friction's Painlevé paradox), the belt holds A.
+    Off the belt: air (but ``on_belt``, where the bird's mode held it on the
+    belt: a gap is then the drift of the constraint that mode integrates,
+    settled here; a lift is the lift-off event). On it: air again if the
+    free motion would lift the lowest point anyway; else stick if A rolls
+    with the belt and the friction it needs is inside the cone, else slip in
+    the direction A moves (or, from rest, the direction the friction cannot
+    hold). If sliding would need a negative normal force (friction's
+    Painlevé paradox), the belt holds A.
     """
     dyn = grasp.dyn
-    if dyn.gap(y) > GAP_TOL and not landing:
+    if dyn.gap(y) > GAP_TOL and not (landing or on_belt):
         return "air", 0.0, y
     y = dyn.land(y) if landing else dyn.settle(y)
     loads, _ = grasp.fingers.evaluate(t, y)
@@ -278,7 +282,7 @@ def _after_event(grasp: Grasp, name: str, t: float, y: np.ndarray, mode: str, sl
         if grasp.solve_mode(t, y, "slip", sign, loads)[1] > 0:
             return "slip", sign, y
         # sliding would need N < 0: decide afresh (air, if the bird lifts)
-    return decide_mode(grasp, t, y, landing=name == "touch-down")
+    return decide_mode(grasp, t, y, landing=name == "touch-down", on_belt=mode != "air")
 
 
 def _keep(grasp: Grasp, traj: Trajectory, record: Record) -> bool:
@@ -361,7 +365,7 @@ def _commit(grasp: Grasp, t: float, y: np.ndarray, mode: str, slip_sign: float):
     pulled = bool(grasp.fingers.touched) and \
         record.normal < -SUPPORT_TOL * grasp.dyn.bird.mass * G
     if (turned or pulled) and mode != "air":
-        mode, slip_sign, y = decide_mode(grasp, t, y)
+        mode, slip_sign, y = decide_mode(grasp, t, y, on_belt=True)
         record = grasp.record(t, y, mode, slip_sign)
     return record, mode, slip_sign, y, turned
 
