@@ -88,6 +88,10 @@ def _call(fn: Callable, job, send) -> None:
     send.close()
 
 
+#: how often (s) jobs waiting for a free core look for one
+LOOK_AGAIN = 0.05
+
+
 def others_running() -> int:
     """Processes running or ready to run on this machine now, besides this
     one: Linux's /proc/loadavg; elsewhere the load average of the last
@@ -139,7 +143,10 @@ class Ahead:
         while True:
             running = [f for f in [*forked, *self._ahead.values()]
                        if f is not None and not f.done()]
-            while len(running) < self.processes and todo:
+            # a job asked for beyond the first runs beside it on a free core
+            # only: two processes on one core take longer than one after the other
+            while todo and (not running or len(running) < self.processes
+                            and others_running() < self.cores):
                 i = todo.pop(0)
                 forked[i] = self._fork(jobs[i])
                 running.append(forked[i])
@@ -153,7 +160,8 @@ class Ahead:
                 return values
             waiting = [f.connection for f in running if not f.done()]
             if waiting:
-                wait(waiting)
+                # jobs waiting for a core look again now and then for a free one
+                wait(waiting, timeout=LOOK_AGAIN if todo else None)
 
     def _fork(self, job) -> _Forked:
         forked = _Forked(self._context, self.fn, job)
