@@ -12,7 +12,9 @@ whether it ran ahead; one no longer wanted is killed.
 
 A job runs ahead only on a core that is free: where other processes keep
 every core busy (two cases of a study, each with its processes), a run
-ahead would take time from the runs asked for.
+ahead would take time from the runs asked for. So does a second job asked
+for: it waits for a free core, as two simulations sharing one take longer
+than one after the other.
 
 A forked process computes exactly what this one would: it starts from this
 process's state at the fork, with its built functions.
