@@ -4,6 +4,8 @@ run ahead is not run again when asked for; one no longer wanted is killed,
 not waited for; a job's exception reaches the caller."""
 
 import os
+import subprocess
+import sys
 import time
 
 import pytest
@@ -95,3 +97,36 @@ def test_forked_map_returns_in_order_what_this_process_would():
     assert [v[0] for v in there] == [v[0] for v in here] == items
     assert os.getpid() not in {v[1] for v in there}
     assert {v[1] for v in here} == {os.getpid()}
+
+
+def test_a_second_job_asked_for_waits_for_a_free_core(ahead, monkeypatch):
+    """Two simulations on one core take longer than one after the other:
+    with every core taken but this call's first job's, its second begins
+    only after the first has ended; with a core free, beside it."""
+    monkeypatch.setattr("design.solvers.optimize.ahead.others_running", lambda: ahead.cores)
+    (_, _, first), (_, _, second) = ahead.run([("sleep", 0.3), ("sleep", 0.0)])
+    assert second - first >= 0.3
+    monkeypatch.setattr("design.solvers.optimize.ahead.others_running", lambda: 0)
+    (_, _, first), (_, _, second) = ahead.run([("sleep", 0.3), ("sleep", 0.0)])
+    assert second - first < 0.25
+
+
+def test_a_process_that_yields_the_cores_is_not_load(monkeypatch):
+    """A background check at a lower priority (design/solvers/optimize/
+    model_check.py) counts as load only while it runs: registered as
+    yielding, a busy one is taken off the machine's running processes, a
+    sleeping one is not running anyway."""
+    from design.solvers.optimize import ahead as module
+    busy = subprocess.Popen([sys.executable, "-c", "while True: pass"])
+    asleep = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(30)"])
+    try:
+        time.sleep(0.5)
+        assert module._runnable(busy.pid) and not module._runnable(asleep.pid)
+        monkeypatch.setattr(module, "YIELDING", {busy.pid, asleep.pid})
+        assert sum(module._runnable(p) for p in module.YIELDING) == 1
+    finally:
+        busy.kill()
+        asleep.kill()
+        busy.wait()
+        asleep.wait()
+    assert not module._runnable(busy.pid)

@@ -94,14 +94,28 @@ def _call(fn: Callable, job, send) -> None:
 LOOK_AGAIN = 0.05
 
 
+#: processes of this run that yield the cores (background checks at a
+#: lower priority, design/solvers/optimize/model_check.py): not load
+YIELDING: set[int] = set()
+
+
 def others_running() -> int:
     """Processes running or ready to run on this machine now, besides this
-    one: Linux's /proc/loadavg; elsewhere the load average of the last
-    minute, rounded."""
+    one and those that yield (:data:`YIELDING`): Linux's /proc/loadavg;
+    elsewhere the load average of the last minute, rounded."""
     try:
-        return int(Path("/proc/loadavg").read_text().split()[3].split("/")[0]) - 1
+        running = int(Path("/proc/loadavg").read_text().split()[3].split("/")[0]) - 1
     except (OSError, ValueError, IndexError):
         return round(os.getloadavg()[0])
+    return running - sum(_runnable(pid) for pid in YIELDING)
+
+
+def _runnable(pid: int) -> bool:
+    """Whether process ``pid`` is running or ready to run (Linux's /proc)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] == "R"
+    except (OSError, IndexError):
+        return False
 
 
 class Ahead:

@@ -14,7 +14,9 @@ is resolved on the spatial baseline's own peak.
 The spatial runs (seconds each on the main problem) go to one background
 process, the baseline's at the start of the run while the optimiser works,
 the optimum's as soon as the design loop has picked it, so that they cost
-the run little wall time on a machine with a free core. Once the run waits
+the run little wall time on a machine with a free core. It runs at a lower
+priority: the design loop's simulations come first (and do not count it as
+load when they look for a free core, design/solvers/optimize/ahead.py). Once the run waits
 for them, its own core is free too, and a second background process takes
 the runs the first has not begun (where there are two cores). A process is
 a fresh interpreter running this module (``python -m``), not a
@@ -42,6 +44,7 @@ import numpy as np
 from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import SPATIAL_NODES, GraspSetup, simulate_grasp
 from design.solvers.grasp.validity import validity_problems
+from design.solvers.optimize.ahead import YIELDING
 from design.solvers.optimize.forked import processes
 from design.solvers.optimize.trust_region import CAP_TOLERANCE
 
@@ -49,6 +52,8 @@ from design.solvers.optimize.trust_region import CAP_TOLERANCE
 CHECK_MODEL, DESIGN_MODEL = "spatial", "planar"
 #: the label of the baseline design's runs
 BASELINE = "baseline"
+#: how much lower the background processes' priority is (Unix niceness)
+NICENESS = 10
 
 
 def spatial_summary(setup: GraspSetup, integrator: IntegratorSettings) -> dict:
@@ -102,6 +107,7 @@ class ModelCheck:
                 process.kill()
                 process.wait()
             process.stdin.close()
+            YIELDING.discard(process.pid)
         self._folder.cleanup()
 
     def _start(self) -> None:
@@ -116,6 +122,7 @@ class ModelCheck:
             [sys.executable, "-m", __spec__.name], stdin=subprocess.PIPE,
             stdout=subprocess.DEVNULL, stderr=log, env=env))
         log.close()
+        YIELDING.add(self._processes[-1].pid)
         self._send(self._processes[-1], self._tasks)
 
     @staticmethod
@@ -240,7 +247,10 @@ def _serve() -> None:
     (another process that claimed it first leaves nothing to rename); its
     :func:`spatial_summary`, or the error, is written beside it as
     ``.result`` (renamed into place whole, so that a reader never sees half
-    of it)."""
+    of it). It runs at a lower priority (:data:`NICENESS`): the design
+    loop's simulations come first, it takes the cores they leave free."""
+    if hasattr(os, "nice"):
+        os.nice(NICENESS)
     for line in sys.stdin:
         task, claimed = Path(line.strip()), Path(line.strip()).with_suffix(".claimed")
         try:
