@@ -144,6 +144,15 @@ def birds(monkeypatch):
     return Population(tuple(Member(f"bird-{b}", b) for b in range(3)))
 
 
+def one_bird(birds, monkeypatch, run):
+    """The first stand-in bird alone, its simulation ``run``, and how the
+    search judges its designs under a 13 N cap: (population, beats, rivals)."""
+    monkeypatch.setattr(pattern_search, "simulate", run)
+    bird = replace(birds, members=birds.members[:1])
+    return (bird, *pattern_search.judges(bird, np.full(1, 13.0),
+                                         SimpleNamespace(objective="hold", min_hold=None)))
+
+
 def test_pairs_on_two_processes_give_what_one_gives(birds):
     """The birds of the designs a search evaluates together go to two forked
     processes, in order, with the values one process computes: each bird's
@@ -228,10 +237,7 @@ def test_a_candidate_ruled_out_does_not_win_a_poll_its_whole_run_would_tie(birds
         on_axis = np.all(d[1:] == 0.5)
         hold = holds.get(float(d[0]), base - 0.01) if on_axis else base - 0.01
         return _stand_in(d, base if np.all(d == 0.5) else hold, FORCE, cutoff)
-    monkeypatch.setattr(pattern_search, "simulate", tie_run)
-    bird = replace(birds, members=birds.members[:1])
-    beats, rivals = pattern_search.judges(bird, np.full(1, 13.0),
-                                          SimpleNamespace(objective="hold", min_hold=None))
+    bird, beats, rivals = one_bird(birds, monkeypatch, tie_run)
     d0 = np.full(4, 0.5)
 
     def searched(rivals):
@@ -250,9 +256,7 @@ def test_a_run_started_ahead_against_another_incumbent_is_not_used(birds, monkey
     design against the same incumbent: asked for against another, the
     design is simulated again, against that one, and the run ahead is
     dropped."""
-    bird = replace(birds, members=birds.members[:1])
-    _, rivals = pattern_search.judges(bird, np.full(1, 13.0),
-                                      SimpleNamespace(objective="hold", min_hold=None))
+    bird, _, rivals = one_bird(birds, monkeypatch, _bird_run)
     monkeypatch.setattr("design.solvers.optimize.ahead.others_running", lambda: 0)
     d = np.full(4, 0.6)
     with Pairs(bird, None, None, 2, rivals) as pool:
@@ -334,27 +338,20 @@ def test_a_design_whose_scene_was_scored_takes_its_score_and_the_search_its_step
     def bird_run(space, d, settings, integrator, cutoff=None):
         return _stand_in(np.asarray(d, float),
                          HOLD - float(np.sum(WEIGHT * (acting(d) - centre) ** 2)), FORCE, cutoff)
-    monkeypatch.setattr(pattern_search, "simulate", bird_run)
-    bird = replace(birds, members=birds.members[:1])
-    beats, _ = pattern_search.judges(bird, np.full(1, 13.0),
-                                     SimpleNamespace(objective="hold", min_hold=None))
+    bird, beats, _ = one_bird(birds, monkeypatch, bird_run)
     d0 = np.full(4, 0.5)
 
-    def searched(scenes):
+    def searched(once: bool):
         with Pairs(bird, None, None, 1) as pool:
-            score = scenes(pool.score).score if scenes else pool.score
+            scenes = Scenes(pool.score, lambda d: tuple(acting(d))) if once else None
+            score = scenes.score if once else pool.score
             start, = score([d0])
-            return compass(score, d0, start, beats, max_evaluations=60), pool
-    once_scenes = []
-
-    def scenes(score):
-        once_scenes.append(Scenes(score, lambda d: tuple(acting(d))))
-        return once_scenes[0]
-    (every, every_pool), (once, once_pool) = searched(None), searched(scenes)
+            return compass(score, d0, start, beats, max_evaluations=60), pool, scenes
+    (every, every_pool, _), (once, once_pool, scenes) = searched(False), searched(True)
     assert [(t.variable, t.units, t.move, t.taken, t.value.hold) for t in every.trials] == \
         [(t.variable, t.units, t.move, t.taken, t.value.hold) for t in once.trials]
     assert np.array_equal(every.d, once.d) and once.d[1] == 1.0
-    repeats = once_scenes[0].repeats
+    repeats = scenes.repeats
     assert len(repeats) >= 3
     assert once_pool.simulations == every_pool.simulations - len(repeats)
     for t in once.trials:
