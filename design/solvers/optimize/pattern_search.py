@@ -88,7 +88,7 @@ LATTICE, FIRST_STEP = 1 / 64, 8
 AHEAD_POLLS = 3
 #: a move must lengthen the hold by more than this (s)
 HOLD_BAND = 1e-4
-#: the default budget of simulations
+#: the default budget of designs evaluated
 MAX_SIMULATIONS = LoopSettings.max_simulations
 
 
@@ -290,7 +290,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             if settings.objective == "throughput" else ""
         say(f"step {abs(trial.units) * LATTICE:g}: {names[trial.variable]} "
             f"{'up' if trial.units > 0 else 'down'} -> {line}hold {trial.value.hold:.4f} s, "
-            f"peak {trial.value.peak:.2f} N ({count} simulations)")
+            f"peak {trial.value.peak:.2f} N ({count} designs evaluated)")
 
     with pool:
         found = compass(scenes.score, origin, first, beats, allowed, max_simulations, moved)
