@@ -181,9 +181,7 @@ def clear_at(grasper: Grasper, bird: Bird, speed: float, fingers: list[int],
         base0, R0 = drum.frame(gf.mount, 0.0)
         base = drum.origin + turns @ (base0 - drum.origin)
         axis = turns @ R0[:, 0]
-        p, e = body(base - centre), body(axis)
-        along = np.clip(-np.sum(p * e, axis=1) / np.sum(e * e, axis=1), 0.0, gf.finger.length)
-        level = np.sum((p + along[:, None] * e) ** 2, axis=1) - 1.0
+        level = scaled_level(body(base - centre), body(axis), gf.finger.length)
         tip_z = base[:, 2] + axis[:, 2] * gf.finger.length
         if np.any(level <= CLEAR_LEVEL) or np.any(tip_z <= CLEAR_HEIGHT):
             return False
@@ -527,8 +525,13 @@ def straight_level(body: Ellipsoid, base: np.ndarray, axis: np.ndarray, length):
     1/λ, 1/γ): a parabola in x. < 0 when the straight finger enters the bird.
     For n fingers at once: base and axis (n, 3), length (n,); returns (n,)."""
     scale = np.array([1 / body.eta, 1 / body.lam, 1 / body.gamma])
-    p = scale * ((base - np.asarray(body.center)) @ body.rotation)
-    e = scale * (axis @ body.rotation)
+    return scaled_level(scale * ((base - np.asarray(body.center)) @ body.rotation),
+                        scale * (axis @ body.rotation), length)
+
+
+def scaled_level(p: np.ndarray, e: np.ndarray, length):
+    """min over 0 ≤ x ≤ length of |p + x e|² - 1: the straight finger's level
+    from its base p and axis e in the bird's scaled body coordinates (n, 3)."""
     x = np.clip(-np.sum(p * e, axis=-1) / np.sum(e * e, axis=-1), 0.0, length)
     q = p + x[..., None] * e
     return np.sum(q * q, axis=-1) - 1.0
