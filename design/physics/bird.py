@@ -83,9 +83,15 @@ class Conveyor:
         return self.final_speed is not None and (self.start_time is not None or
                                                  self.start_position is not None)
 
+    @property
+    def changes(self) -> bool:
+        """Whether the belt's speed changes: it decelerates to a final speed
+        other than its own."""
+        return self.decelerates and self.final_speed != self.speed
+
     def velocity(self, t: float, start: float | None) -> tuple[float, float]:
         """Speed (m/s) and acceleration (m/s²) at t, given the start time."""
-        if not self.decelerates or start is None or self.final_speed == self.speed:
+        if not self.changes or start is None:
             return self.speed, 0.0
         v, v_dot, _ = belt_motion(t, self.speed, self.final_speed, self.rate, start)
         return v, v_dot

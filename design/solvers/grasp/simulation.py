@@ -111,7 +111,7 @@ def setup_reach_windows(setup: GraspSetup) -> list[list[tuple[float, float]]]:
         return reach_windows(setup.grasper, b, setup.drum_speed,
                              lambda t: (setup.start_x + speed * t, b.gamma), setup.duration)
 
-    if not conv.decelerates or conv.final_speed == conv.speed:
+    if not conv.changes:
         return windows_at(conv.speed)
     return [_union(w1, w2) for w1, w2 in zip(windows_at(conv.final_speed),
                                              windows_at(conv.speed))]
