@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -25,6 +26,7 @@ from scipy.integrate import solve_bvp
 from design.physics.beam import Finger
 from design.physics.kinematics import rot_x
 from design.physics.stiffness import UniformEI
+from design.reproduce.grasp import football_setup
 from design.solvers.contact import RobustContact
 from design.solvers.contact.belt_continuation import (EVENT_DEPTH, GRAZE_DEPTH, BeltedContact,
                                                       Belted,
@@ -527,3 +529,57 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
                                spatial_law(0.0), resting(fresh))
         assert sol.normal_force == pytest.approx(alone.normal_force, abs=1e-12)
         assert sol.belt_normal_force == pytest.approx(alone.belt_normal_force, abs=1e-12)
+
+
+def fold_case():
+    """Finger 5a of the football scene (Table 5-1's lower finger, 152 mm, the
+    rod on 3 intervals as the scene meshes it) pressing the ball onto the
+    belt at an accepted instant 1.3475 s into the run, and a trial 0.1 ms
+    later past the fold where that contact ends (tests/data/football_fold.npz,
+    saved from the run): a fresh solver, the accepted state (with the
+    Jacobian inverse its commit keeps) and the trial's bird, laws and belt."""
+    d = np.load(Path(__file__).parent / "data" / "football_fold.npz")
+    finger = next(gf.finger for gf in football_setup().grasper.fingers if gf.name == "5a")
+    belted = SpatialBeltContact(SpatialContact(finger, intervals=3))
+    previous = belted.with_inverse(Belted(
+        str(d["mode"]), d["z"], d["bird"], d["pfriction"], Plane.from_params(d["pplane"]),
+        d["pbelt"], d["post"], float(d["held"]), int(d["side"]), graze=float(d["graze"])))
+    target = (Quadric.from_params(d["quadric"]), law(d["friction"]), Plane.from_params(d["plane"]),
+              law(d["belt"]))
+    return belted, previous, target
+
+
+def law(p: np.ndarray) -> FrictionLaw:
+    """The friction law of the parameters ``FrictionLaw.params``."""
+    return FrictionLaw(given=p[:3], mu=p[3], speed=p[4], sliding_at_origin=p[5:8],
+                       sliding_gradient=p[8:].reshape(3, 3))
+
+
+def test_a_trial_past_a_fold_finds_at_its_coarser_stall_what_the_accepted_instant_finds():
+    """Past the fold the continued equilibrium ends: a trial, stalled at a
+    step of TRIAL_STALL_STEP, and the accepted instant, at STALL_STEP, both
+    lose it and find the same state afresh (the finger off the ball, on the
+    belt: 1e-9 N), the trial for under half the Newton solves (each halving
+    of the step near a fold costs two failed ones)."""
+    found = []
+    for trial in (True, False):
+        belted, previous, target = fold_case()
+        sol, state = belted.solve(*target, previous=previous, detail=False, trial=trial)
+        assert sol.converged and sol.extras["continuation_lost"], sol.message
+        found.append((sol, state, belted.newton_total))
+    (trial, t_state, t_cost), (commit, c_state, c_cost) = found
+    assert t_state.mode == c_state.mode == "belt"
+    assert trial.belt_normal_force == pytest.approx(commit.belt_normal_force, abs=1e-9)
+    assert t_cost < c_cost / 2
+
+
+def test_a_trial_short_of_the_fold_follows_the_continued_equilibrium():
+    """Halfway to the trial past the fold, both stalls follow the ball: the
+    same state (1e-9 N), nothing lost."""
+    belted, previous, target = fold_case()
+    quadric = Quadric.from_params((previous.bird + target[0].params) / 2)
+    sols = [belted.solve(quadric, *target[1:], previous=previous, detail=False, trial=trial)[0]
+            for trial in (True, False)]
+    assert not any(s.extras["continuation_lost"] for s in sols)
+    assert sols[0].normal_force > 0.0
+    assert sols[0].normal_force == pytest.approx(sols[1].normal_force, abs=1e-9)

@@ -42,6 +42,22 @@ def test_the_loads_are_a_function_of_the_state():
                                atol=1e-9 * np.abs(loads).max())
 
 
+def main_job_fingers(copies: int) -> tuple[list[FingerForces], tuple[np.ndarray, np.ndarray]]:
+    """The main job's scene with the bird at X0 = -0.075 m on the belt:
+    ``copies`` spatial FingerForces committed at t = 0, and the bird's
+    states 4 and 8 ms on (riding the belt)."""
+    setup = setup_of(load_scene(Path(__file__).parents[1] / "problems" / "hold_time.yaml").scene)
+    b = setup.bird
+    y0 = np.array([MEAN_START, b.gamma + 0.002, 0.0, setup.conveyor.speed, 0.0, 0.0])
+    forces = [FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction,
+                           model="spatial", intervals=6, belt=setup.belt,
+                           belt_friction=setup.finger_belt_friction) for _ in range(copies)]
+    for f in forces:
+        f.evaluate(0.0, y0, commit=True)
+    return forces, tuple(y0 + dt * np.concatenate([y0[3:], [0.0, 0.0, 0.0]])
+                         for dt in (0.004, 0.008))
+
+
 def test_a_commit_keeps_the_trial_solved_at_its_instant():
     """An accepted instant's commit reuses the trial evaluated there (an
     adaptive step's last stage), solving again only the fingers the trial
@@ -52,15 +68,7 @@ def test_a_commit_keeps_the_trial_solved_at_its_instant():
     next trial's loads. The main job's scene with the bird at X0 = -0.075 m:
     finger 4a presses it (a bird-only contact), the three fingers 5 rest on
     the belt."""
-    setup = setup_of(load_scene(Path(__file__).parents[1] / "problems" / "hold_time.yaml").scene)
-    b = setup.bird
-    y0 = np.array([MEAN_START, b.gamma + 0.002, 0.0, setup.conveyor.speed, 0.0, 0.0])
-    y1, y2 = (y0 + dt * np.concatenate([y0[3:], [0.0, 0.0, 0.0]]) for dt in (0.004, 0.008))
-    reused, fresh = (FingerForces(setup.grasper, b, setup.drum_speed, setup.finger_friction,
-                                  model="spatial", intervals=6, belt=setup.belt,
-                                  belt_friction=setup.finger_belt_friction) for _ in range(2))
-    for f in (reused, fresh):
-        f.evaluate(0.0, y0, commit=True)
+    (reused, fresh), (y1, y2) = main_job_fingers(2)
     reused.evaluate(0.004, y1)
     solves = reused.solves
     kept, kept_states = reused.evaluate(0.004, y1, commit=True)
@@ -80,6 +88,20 @@ def test_a_commit_keeps_the_trial_solved_at_its_instant():
             assert np.array_equal(k.continued.inverse, s.continued.inverse)
     nxt = [f.evaluate(0.008, y2)[0] for f in (reused, fresh)]
     assert (nxt[0].qx, nxt[0].qz, nxt[0].ty) == (nxt[1].qx, nxt[1].qz, nxt[1].ty)
+
+
+def test_a_commit_solves_again_where_its_trial_lost_the_continued_equilibrium():
+    """A trial finds a fold at a coarser stall than a commit
+    (design/solvers/contact/belt_continuation.py): where one of its fingers
+    lost the continued equilibrium, the commit at its instant solves every
+    finger again instead of keeping the trial."""
+    ([fingers], (y1, _)) = main_job_fingers(1)
+    _, states = fingers.evaluate(0.004, y1)
+    pressing = next(s for s in states if s.solution is not None)      # finger 4a
+    pressing.solution.extras["continuation_lost"] = True
+    solves = fingers.solves
+    _, committed = fingers.evaluate(0.004, y1, commit=True)
+    assert fingers.solves == solves + sum(s.solution is not None for s in committed) == solves + 4
 
 
 def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():

@@ -16,7 +16,8 @@ import numpy as np
 from design.physics.rod import quaternion_rotation
 from design.solvers.beam.collocation import legendre_tables
 from design.solvers.beam.rod import N_STATE
-from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, Belted,
+from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES,
+                                                    STALL_STEP, TRIAL_STALL_STEP, Belted,
                                                     BeltedContact, Deepest, Plane, deepest)
 from design.solvers.contact.robust import BASE_FRACTION
 from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
@@ -60,20 +61,24 @@ class SpatialBeltContact(BeltedContact):
 
     # ----------------------------------------------------------------- API
     def solve(self, quadric: Quadric | None, friction, plane: Plane, belt,
-              previous: Belted | None = None, detail: bool = True
+              previous: Belted | None = None, detail: bool = True, trial: bool = False
               ) -> tuple[SpatialSolution, Belted | None]:
         """The finger against ``quadric`` (the bird in the finger frame; None
         when it cannot be reached) under the friction law ``friction``, and
         the belt ``plane`` under the law ``belt``, continued from
-        ``previous``. Returns the solution and the state to continue from."""
+        ``previous`` (``trial``: an integrator's trial from its accepted
+        state, lost at a coarser stall). Returns the solution, whose extras'
+        ``continuation_lost`` says whether it was found afresh, and the
+        state to continue from."""
         if quadric is not None and quadric.level(np.zeros((3, 1)))[0] <= 0.0:
             return self._failed("the finger base is inside the object: invalid pose"), None
         target = Belted("free", None, None if quadric is None else quadric.params,
                         FrictionLaw.of(friction).params, plane, FrictionLaw.of(belt).params)
-        state, msg = self.continued(target, previous)
+        state, msg = self.continued(target, previous, TRIAL_STALL_STEP if trial else STALL_STEP)
         if state is None:
             return self._failed(msg), None
         sol = self._solution(state, msg)
+        sol.extras["continuation_lost"] = self.lost
         return self.detailed(sol, state) if detail else (sol, state)
 
     def detailed(self, sol: SpatialSolution, state: Belted) -> tuple[SpatialSolution, Belted]:

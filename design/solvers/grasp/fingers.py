@@ -119,6 +119,13 @@ class FingerState:
         """The finger's normal force on the belt (N; 0 off the belt)."""
         return float(getattr(self.solution, "belt_normal_force", 0.0))
 
+    @property
+    def lost(self) -> bool:
+        """Whether its solve lost the equilibrium continued from the accepted
+        state and found one afresh (a trial finds that at a coarser stall
+        than a commit: design/solvers/contact/belt_continuation.py)."""
+        return self.solution is not None and bool(self.solution.extras.get("continuation_lost"))
+
 
 #: every finger out of reach, at every evaluation: one state, read-only
 OUT_OF_REACH = FingerState()
@@ -479,7 +486,7 @@ class SpatialFinger:
         """The finger with the belt and the bird (its continuation finds where
         the bent finger first meets the bird)."""
         sol, cont = self.belted.solve(quadric, self._law(kin_factory, quadric), belt[0], belt[1],
-                                      start, detail=commit)
+                                      start, detail=commit, trial=not commit)
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
@@ -684,7 +691,8 @@ class FingerForces:
         if not commit and memo is not None:
             return memo[0]
         waiting = self._waiting() if commit else set()
-        if commit and memo is not None and self._trials_from_committed:
+        if commit and memo is not None and self._trials_from_committed and \
+                not any(st.lost for st in memo[0][1]):
             out, skipped = self._commit_trial(t, y, *memo), ()
         else:
             out, skipped = self._evaluate(t, y, commit)
@@ -787,7 +795,9 @@ class FingerForces:
                       skipped: list[int]) -> tuple[Loads, list[FingerState]]:
         """Commit the trial evaluation at (t, y): where every trial continues
         from the committed contacts (``from_committed``), the trial solved
-        what the commit would, and the commit only adds each solve's detail
+        what the commit would (not where one lost its continued equilibrium,
+        which a trial finds at a coarser stall: the commit then solves
+        every finger again), and the commit only adds each solve's detail
         and each contact's out-of-plane shares, and solves the fingers the
         trial left out (``skipped``). (An adaptive Runge-Kutta step's last
         stage is evaluated where the step ends, the instant then accepted.)"""
