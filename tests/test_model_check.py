@@ -18,7 +18,6 @@ from design.io.design_problem import Cap
 from design.io.scene import load_scene
 from design.run.solve import design_space
 from design.solvers.grasp.simulation import simulate_grasp
-from design.solvers.optimize.forked import processes
 from design.solvers.optimize.model_check import ModelCheck, check_text, compare, spatial_summary
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.trust_region import LOOP_SIMULATOR
@@ -81,11 +80,11 @@ def test_closing_stops_a_run_in_progress():
     assert process.poll() is not None and time.perf_counter() - t0 < 5.0
 
 
-@pytest.mark.skipif(processes(None) < 2, reason="one core: no second background process")
-def test_a_second_process_takes_the_runs_the_first_has_not_begun_while_the_run_waits():
-    """Three short spatial runs queued, then waited for: a second process
-    starts, each run is claimed by one process only (none left unclaimed,
-    none repeated), and each gives what this process computes."""
+def test_the_waiting_process_makes_the_runs_the_background_has_not_begun():
+    """Three short spatial runs queued, then waited for at once: this
+    process makes some of them itself (the background one is still
+    starting), each run is claimed by one process only (none left
+    unclaimed, none repeated), and each gives what this process computes."""
     space = placed_bird(0.02)
     setups = [space.setup(d) for d in (space.scale(space.base_values), np.full(8, 0.3),
                                        np.full(8, 0.6))]
@@ -93,7 +92,7 @@ def test_a_second_process_takes_the_runs_the_first_has_not_begun_while_the_run_w
         check.submit_setups("three", setups)
         runs = check.runs("three")
         folder = Path(check._folder.name)
-        assert len(check._processes) == 2
+        assert len(check._processes) == 1 and check.ran_here >= 1
         assert sorted(p.name for p in folder.glob("*.claimed")) == \
             ["1.claimed", "2.claimed", "3.claimed"] and not list(folder.glob("*.task"))
     for setup, run in zip(setups, runs):

@@ -45,7 +45,6 @@ from design.solvers.grasp.integrate import IntegratorSettings
 from design.solvers.grasp.simulation import SPATIAL_NODES, GraspSetup, simulate_grasp
 from design.solvers.grasp.validity import validity_problems
 from design.solvers.optimize.ahead import YIELDING
-from design.solvers.optimize.forked import processes
 from design.solvers.optimize.trust_region import CAP_TOLERANCE
 
 #: the model the check runs and the one it checks
@@ -80,8 +79,9 @@ class ModelCheck:
     ``submit(label, population, d)`` queues every bird's run of the scaled
     design d, ``submit_setups(label, setups)`` any scenes' (the robustness
     table's, design/solvers/optimize/robustness.py); ``result(...)`` waits
-    for a baseline's and an optimum's runs and compares them, on a second
-    process while it waits. ``close()`` (or the ``with`` block) stops the
+    for a baseline's and an optimum's runs and compares them, making the
+    runs the background process has not begun itself while it waits
+    (:attr:`ran_here`). ``close()`` (or the ``with`` block) stops the
     processes, also amid a run (Ctrl-C, a failed case): a simulation still
     running there is not waited for."""
 
@@ -94,6 +94,8 @@ class ModelCheck:
         self._processes: list[subprocess.Popen] = []
         self._tasks: list[Path] = []
         self._runs: dict[str, list[Path]] = {}
+        #: runs this process made itself while it waited
+        self.ran_here = 0
 
     def __enter__(self) -> ModelCheck:
         return self
@@ -154,9 +156,11 @@ class ModelCheck:
         self._runs[label] = [task.with_suffix(".result") for task in tasks]
 
     def _wait(self, path: Path) -> dict:
-        if not path.exists() and len(self._processes) < processes(None):
-            self._start()                       # this process only waits: its core is free
         while not path.exists():
+            # this process only waits: its core makes a run no process has begun
+            if any(_claim_and_run(task) for task in self._tasks):
+                self.ran_here += 1
+                continue
             for k, process in enumerate(self._processes):
                 if process.poll() is not None:
                     log = (Path(self._folder.name) / f"worker{k}.log").read_text(
@@ -243,27 +247,35 @@ def check_text(check: dict) -> str:
 
 def _serve() -> None:
     """The background process: each line of standard input names a task
-    file (a pickled setup and integrator), which it claims by renaming it
-    (another process that claimed it first leaves nothing to rename); its
-    :func:`spatial_summary`, or the error, is written beside it as
-    ``.result`` (renamed into place whole, so that a reader never sees half
-    of it). It runs at a lower priority (:data:`NICENESS`): the design
-    loop's simulations come first, it takes the cores they leave free."""
+    file, whose run it makes (:func:`_claim_and_run`). It runs at a lower
+    priority (:data:`NICENESS`): the design loop's simulations come first,
+    it takes the cores they leave free."""
     if hasattr(os, "nice"):
         os.nice(NICENESS)
     for line in sys.stdin:
-        task, claimed = Path(line.strip()), Path(line.strip()).with_suffix(".claimed")
-        try:
-            task.rename(claimed)
-        except FileNotFoundError:
-            continue
-        try:
-            run = spatial_summary(*pickle.loads(claimed.read_bytes()))
-        except Exception as exc:                 # noqa: BLE001  reported by the waiting run
-            run = {"error": f"{type(exc).__name__}: {exc}"}
-        partial = task.with_suffix(".partial")
-        partial.write_bytes(pickle.dumps(run))
-        partial.replace(task.with_suffix(".result"))
+        _claim_and_run(Path(line.strip()))
+
+
+def _claim_and_run(task: Path) -> bool:
+    """Make the run of the task file ``task`` (a pickled setup and
+    integrator) unless a process has claimed it: claimed by renaming it
+    (another process that claimed it first leaves nothing to rename), its
+    :func:`spatial_summary`, or the error, written beside it as ``.result``
+    (renamed into place whole, so that a reader never sees half of it).
+    Whether it made it."""
+    claimed = task.with_suffix(".claimed")
+    try:
+        task.rename(claimed)
+    except FileNotFoundError:
+        return False
+    try:
+        run = spatial_summary(*pickle.loads(claimed.read_bytes()))
+    except Exception as exc:                     # noqa: BLE001  reported by the waiting run
+        run = {"error": f"{type(exc).__name__}: {exc}"}
+    partial = task.with_suffix(".partial")
+    partial.write_bytes(pickle.dumps(run))
+    partial.replace(task.with_suffix(".result"))
+    return True
 
 
 if __name__ == "__main__":
