@@ -17,8 +17,9 @@ the optimum's as soon as the design loop has picked it, so that they cost
 the run little wall time on a machine with a free core. It runs at a lower
 priority: the design loop's simulations come first (and do not count it as
 load when they look for a free core, design/solvers/optimize/ahead.py). Once the run waits
-for them, its own core is free too, and a second background process takes
-the runs the first has not begun (where there are two cores). A process is
+for them, its own core is free too, and it makes the runs the background
+process has not begun itself (a second process would spend that wait
+importing and building). The background process is
 a fresh interpreter running this module (``python -m``), not a
 multiprocessing child: those import the caller's main script again, which
 would run a user's unguarded ``design.api.solve(...)`` script twice. Tasks
