@@ -74,7 +74,7 @@ def test_closing_stops_a_run_in_progress():
     check = ModelCheck(LOOP_SIMULATOR)
     check.submit("baseline", Population.of(space), space.scale(space.base_values))
     time.sleep(1.0)                          # the process is importing or running
-    process = check._processes[0]
+    process = check._process
     t0 = time.perf_counter()
     check.close()
     assert process.poll() is not None and time.perf_counter() - t0 < 5.0
@@ -92,7 +92,7 @@ def test_the_waiting_process_makes_the_runs_the_background_has_not_begun():
         check.submit_setups("three", setups)
         runs = check.runs("three")
         folder = Path(check._folder.name)
-        assert len(check._processes) == 1 and check.ran_here >= 1
+        assert check.ran_here >= 1
         assert sorted(p.name for p in folder.glob("*.claimed")) == \
             ["1.claimed", "2.claimed", "3.claimed"] and not list(folder.glob("*.task"))
     for setup, run in zip(setups, runs):

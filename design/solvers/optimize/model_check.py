@@ -92,7 +92,8 @@ class ModelCheck:
     def __init__(self, integrator: IntegratorSettings):
         self.integrator = integrator
         self._folder = tempfile.TemporaryDirectory(prefix="design-model-check-")
-        self._processes: list[subprocess.Popen] = []
+        #: the background interpreter (started with the first task)
+        self._process: subprocess.Popen | None = None
         self._tasks: list[Path] = []
         self._runs: dict[str, list[Path]] = {}
         #: runs this process made itself while it waited
@@ -105,7 +106,8 @@ class ModelCheck:
         self.close()
 
     def close(self) -> None:
-        for process in self._processes:
+        process = self._process
+        if process is not None:
             if process.poll() is None:
                 process.kill()
                 process.wait()
@@ -113,25 +115,25 @@ class ModelCheck:
             YIELDING.discard(process.pid)
         self._folder.cleanup()
 
+    @property
+    def _log(self) -> Path:
+        return Path(self._folder.name) / "worker.log"
+
     def _start(self) -> None:
-        """One more background interpreter, given every task so far (it
-        skips those claimed); it finds this package where this process
-        found it."""
+        """The background interpreter; it finds this package where this
+        process found it."""
         root = str(Path(__file__).resolve().parents[3])
         env = dict(os.environ)
         env["PYTHONPATH"] = os.pathsep.join(p for p in (root, env.get("PYTHONPATH")) if p)
-        log = open(Path(self._folder.name) / f"worker{len(self._processes)}.log", "wb")
-        self._processes.append(subprocess.Popen(
-            [sys.executable, "-m", __spec__.name], stdin=subprocess.PIPE,
-            stdout=subprocess.DEVNULL, stderr=log, env=env))
-        log.close()
-        YIELDING.add(self._processes[-1].pid)
-        self._send(self._processes[-1], self._tasks)
+        with open(self._log, "wb") as log:
+            self._process = subprocess.Popen(
+                [sys.executable, "-m", __spec__.name], stdin=subprocess.PIPE,
+                stdout=subprocess.DEVNULL, stderr=log, env=env)
+        YIELDING.add(self._process.pid)
 
-    @staticmethod
-    def _send(process: subprocess.Popen, tasks: list[Path]) -> None:
-        process.stdin.write("".join(f"{task}\n" for task in tasks).encode())
-        process.stdin.flush()
+    def _send(self, tasks: list[Path]) -> None:
+        self._process.stdin.write("".join(f"{task}\n" for task in tasks).encode())
+        self._process.stdin.flush()
 
     def submit(self, label: str, population, d: np.ndarray) -> None:
         """Queue the spatial runs of design d (scaled) for every bird, once per label."""
@@ -149,11 +151,9 @@ class ModelCheck:
             task.write_bytes(pickle.dumps((setup, integrator or self.integrator)))
             tasks.append(task)
         self._tasks += tasks
-        if not self._processes:
+        if self._process is None:
             self._start()
-        else:
-            for process in self._processes:
-                self._send(process, tasks)
+        self._send(tasks)
         self._runs[label] = [task.with_suffix(".result") for task in tasks]
 
     def _wait(self, path: Path) -> dict:
@@ -162,13 +162,11 @@ class ModelCheck:
             if any(_claim_and_run(task) for task in self._tasks):
                 self.ran_here += 1
                 continue
-            for k, process in enumerate(self._processes):
-                if process.poll() is not None:
-                    log = (Path(self._folder.name) / f"worker{k}.log").read_text(
-                        errors="replace")
-                    raise RuntimeError(f"the spatial check's process ended (exit status "
-                                       f"{process.returncode}) before its run "
-                                       f"{path.stem}: {log.strip()[-2000:]}")
+            if self._process.poll() is not None:
+                log = self._log.read_text(errors="replace")
+                raise RuntimeError(f"the spatial check's process ended (exit status "
+                                   f"{self._process.returncode}) before its run "
+                                   f"{path.stem}: {log.strip()[-2000:]}")
             time.sleep(self.POLL)
         run = pickle.loads(path.read_bytes())
         if "error" in run:
