@@ -29,6 +29,12 @@ def test_shipped_problems_are_valid():
         assert isinstance(result.value, DesignProblem) and result.value.variables
 
 
+def test_the_pattern_searchs_lattice_is_the_problems_or_64():
+    solver = {"method": "pattern", "time_step": 0.005}
+    assert design.check(problem(solver=solver)).value.settings.lattice == 64
+    assert design.check(problem(solver={**solver, "lattice": 16})).value.settings.lattice == 16
+
+
 def test_units_and_caps_are_read_in_si():
     p = design.check(problem(variables={"fingers.4.angle": ["100 deg", "120 deg"],
                                         "conveyor.rate": ["50 cm/s^2", "3 m/s^2"]},
@@ -57,6 +63,8 @@ def test_units_and_caps_are_read_in_si():
     ({"variables": {"groups.lower.stiffness_scale": [0, 2]}},
      "variables.groups.lower.stiffness_scale", "must be > 0"),
     ({"solver": {"time_step": 2}}, "solver.time_step", "outside the accepted range"),
+    ({"solver": {"lattice": 48}}, "solver.lattice", "48 is not a power of two"),
+    ({"solver": {"lattice": 4}}, "solver.lattice", "outside the accepted range"),
     ({"solver": {"method": "simplex"}}, "solver.method",
      "'simplex' is not one of: trust-region, pattern"),
     ({"scene": "no_such_scene.yaml"}, "scene", "cannot find"),

@@ -12,6 +12,8 @@ import pytest
 
 from design.solvers.optimize import pattern_search, trust_region
 from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
+
+UNIT = 1 / LATTICE
 from design.solvers.optimize.scenes import Scenes
 from design.solvers.optimize.population import Member, Population
 from design.solvers.optimize.trust_region import Evaluated
@@ -44,10 +46,10 @@ def test_the_search_ends_at_the_lattice_optimum():
     d0 = np.full(4, 0.5)
     found = run(d0)
     assert found.lattice_optimum
-    assert np.all(np.abs(found.d - CENTRE) <= LATTICE / 2 + 1e-12)
+    assert np.all(np.abs(found.d - CENTRE) <= UNIT / 2 + 1e-12)
     for i in range(4):
         for s in (1, -1):
-            neighbour = np.clip(found.d + s * LATTICE * np.eye(4)[i], 0, 1)
+            neighbour = np.clip(found.d + s * UNIT * np.eye(4)[i], 0, 1)
             assert quadratic(neighbour) <= found.value + 1e-12
 
 
@@ -58,7 +60,7 @@ def test_round_off_does_not_move_the_path(monkeypatch):
     tie: without the band the round-off picks one of them, with it neither
     displaces the other."""
     monkeypatch.setattr("tests.test_pattern_search.CENTRE",
-                        np.array([0.5 + 3.5 * LATTICE, 0.23, 0.5, 0.9]))
+                        np.array([0.5 + 3.5 * UNIT, 0.23, 0.5, 0.9]))
     d0 = np.array([0.5, 0.5, 0.5, 0.3])
 
     def moves(found):
@@ -96,15 +98,31 @@ def test_the_budget_and_the_allowed_region_are_kept():
         return d[0] + d[3] <= 1.2
     kept = run(d0, allowed=allowed)
     assert all(allowed(t.d) for t in kept.trials) and allowed(kept.d)
-    assert kept.d[0] + kept.d[3] == pytest.approx(1.2, abs=2 * LATTICE)
+    assert kept.d[0] + kept.d[3] == pytest.approx(1.2, abs=2 * UNIT)
 
 
 def test_steps_halve_from_an_eighth_to_one_lattice_unit_and_stop_at_the_box():
     d0 = np.array([0.95, 0.5, 0.5, 0.5])
     found = run(d0)
     steps = sorted({abs(t.units) for t in found.trials}, reverse=True)
-    assert steps == [FIRST_STEP >> n for n in range(len(steps))] and steps[-1] == 1
+    assert steps == [LATTICE // FIRST_STEP >> n for n in range(len(steps))] and steps[-1] == 1
     assert np.all((found.d >= 0) & (found.d <= 1))
+
+
+def test_a_coarser_lattice_takes_the_finer_ones_steps_and_stops_sooner():
+    """On 1/32 of each box the search makes the 1/64 search's first trials
+    (the same points in the same order, the same moves) and ends on the
+    point the finer search stood at when its step first fell to 1/64: a
+    lattice optimum of its own, one unit short of the finer answer."""
+    d0 = np.full(4, 0.5)
+    fine, coarse = run(d0), run(d0, lattice=32)
+    n = len(coarse.trials)
+    assert 0 < n < len(fine.trials)
+    assert all(np.array_equal(a.d, b.d) and a.taken == b.taken and 2 * a.units == b.units
+               for a, b in zip(coarse.trials, fine.trials[:n]))
+    assert abs(fine.trials[n].units) == 1 and all(abs(t.units) > 1 for t in fine.trials[:n])
+    assert coarse.lattice_optimum and np.all(np.abs(coarse.d - CENTRE) <= 1 / 64 + 1e-12)
+    assert coarse.value <= fine.value
 
 
 #: a stand-in finger, fold force, birds' centres and hold weights for
@@ -229,8 +247,8 @@ def test_a_candidate_ruled_out_does_not_win_a_poll_its_whole_run_would_tie(birds
     longer than the incumbent's, not by one within the band of it, so the
     search that rules candidates out takes no move either."""
     band, base = pattern_search.HOLD_BAND, 0.5
-    holds = {0.5 + FIRST_STEP * LATTICE: base + 0.6 * band,
-             0.5 - FIRST_STEP * LATTICE: base + 1.2 * band}
+    holds = {0.5 + 1 / FIRST_STEP: base + 0.6 * band,
+             0.5 - 1 / FIRST_STEP: base + 1.2 * band}
 
     def tie_run(space, d, settings, integrator, cutoff=None):
         d = np.asarray(d, float)

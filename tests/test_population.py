@@ -314,8 +314,8 @@ def test_the_screen_searches_for_a_lifted_bird_within_its_limits(monkeypatch):
 
     seen = {}
 
-    def compass(evaluate, start, first, beats, allowed, budget, enough):
-        seen.update(beats=beats, enough=enough)
+    def compass(evaluate, start, first, beats, allowed, budget, enough, lattice):
+        seen.update(beats=beats, enough=enough, lattice=lattice)
         return SimpleNamespace(d=start, value=first, trials=[])
 
     monkeypatch.setattr(feasibility, "Pairs", Pool)
@@ -329,6 +329,7 @@ def test_the_screen_searches_for_a_lifted_bird_within_its_limits(monkeypatch):
     assert beats(pressed, never_lifted) and not beats(never_lifted, pressed)
     assert beats(held, pressed) and beats(Design(0.09, 0.5), pressed)
     assert [enough(d) for d in (pressed, never_lifted, held)] == [False, False, True]
+    assert seen["lattice"] == LOOP.lattice
     assert (found.within, found.reached, found.simulations) == (True, False, 1)
 
 

@@ -30,7 +30,7 @@ def placed():
 def moved(space, d, name: str, units: int) -> np.ndarray:
     """``d`` with variable ``name`` moved by ``units`` lattice units."""
     out = np.array(d, float)
-    out[[v.name for v in space.variables].index(name)] += units * LATTICE
+    out[[v.name for v in space.variables].index(name)] += units / LATTICE
     return out
 
 

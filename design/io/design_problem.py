@@ -31,7 +31,10 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # method: trust-region (default: Ipopt moves the design)
                                # or pattern (the simulator's lattice search, the same
                                # answer under round-off: pattern_search.py); pattern's
-                               # max_simulations: designs evaluated (150)
+                               # max_simulations: designs evaluated (150), lattice:
+                               # each box in this many units, the finest step (64;
+                               # a power of two from 8 to 1024: a coarser lattice
+                               # ends the search sooner, on a coarser point)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.speed|start_time|rate|final_speed``,
@@ -419,7 +422,7 @@ def _rules(reader: Reader, value: object) -> Rules | None:
 
 #: a design problem's integer solver options: [lowest, highest]
 SOLVER_INTEGERS = {"beam_intervals": (2, 32), "max_iter": (1, 10000), "outer_iterations": (0, 100),
-                   "max_simulations": (1, 10000)}
+                   "max_simulations": (1, 10000), "lattice": (8, 1024)}
 #: its other numeric solver options: dimension, lowest, highest, lowest excluded
 SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
                      "tolerance": ("dimensionless", 1e-12, 1e-2, False),
@@ -439,6 +442,10 @@ def _solver(reader: Reader, value: object) -> dict | None:
                                         lo_open=lo_open)
                    for key, (dimension, lo, hi, lo_open) in SOLVER_QUANTITIES.items()
                    if key in spec})
+    if stated.get("lattice") and stated["lattice"] & (stated["lattice"] - 1):
+        reader.add(join("solver", "lattice"), f"{stated['lattice']} is not a power of two "
+                                              "(8, 16, 32, ... 1024)")
+        stated["lattice"] = None
     if "method" in spec:
         stated["method"] = reader.choice(spec, "method", "solver", LOOP_METHODS)
     if "ipopt" in spec:

@@ -114,7 +114,7 @@ def screen(bird: Population, cap: float, settings: LoopSettings, rules: Rules,
     with pool:
         first, = pool.score([start])
         found = compass(pool.score, start, first, beats, allowed_by(bird.space, rules),
-                        budget, enough=reached)
+                        budget, enough=reached, lattice=settings.lattice)
     return Screened(start, found.d, found.value, len(found.trials) + 1,
                     found.value.within(cap), reached(found.value))
 

@@ -6,15 +6,16 @@ converged at that limit, the iterate follows Ipopt's line-search and filter
 decisions, and round-off (another CPU's BLAS kernels, compiled against
 interpreted functions, a baseline changed in its ninth digit) flips one and
 gives another design. This loop uses the simulator alone and visits only the
-points of a lattice around the start, ``d = clip(d0 + k / 64)`` with
-integer ``k`` (scaled variables), so two runs can differ only where a
-comparison of two simulated holds or of a peak with the cap flips:
+points of a lattice around the start, ``d = clip(d0 + k / n)`` with
+integer ``k`` (scaled variables; ``n`` = 64 unless the problem states its
+``lattice``), so two runs can differ only where a comparison of two
+simulated holds or of a peak with the cap flips:
 
-* a coordinate search with a step of 8 lattice units (1/8 of each box),
-  then 4, 2, 1: for each variable in the problem's order it simulates one
+* a coordinate search with a step of ``n / 8`` lattice units (1/8 of each
+  box), halved down to one unit: for each variable in the problem's order it simulates one
   step up and one down; the better of the two (up on a tie) is taken if it
   beats the incumbent, and the search keeps going that way, each step twice
-  the last (at most 8 units), two steps simulated together, while each
+  the last (at most 1/8 of the box), two steps simulated together, while each
   beats the last; a sweep that moves nothing halves the step;
 * "beats" is :func:`~trust_region.better` with a band: a longer hold by more
   than :data:`HOLD_BAND` (0.1 ms: a smaller gain is not worth a move, and
@@ -82,8 +83,13 @@ from design.solvers.optimize.trust_region import (Evaluated, LoopSettings, Outco
                                                    check_baseline, population_of, simulate)
 from design.solvers.optimize.variables import DesignSpace
 
-#: the lattice's unit and the first step, in lattice units (scaled variables)
-LATTICE, FIRST_STEP = 1 / 64, 8
+#: the default lattice: each variable's box in this many units; a coarser
+#: one (a power of two, at least :data:`FIRST_STEP`) takes the finer one's
+#: steps, until one is clipped at the box's edge, and ends where the finer
+#: one's step first falls below its unit
+LATTICE = LoopSettings.lattice
+#: the first step is 1/FIRST_STEP of each box
+FIRST_STEP = 8
 #: the polls whose points may run ahead on a free core
 AHEAD_POLLS = 3
 #: a move must lengthen the hold by more than this (s)
@@ -118,9 +124,10 @@ class Searched:
 
 
 def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True,
-            max_evaluations: int = MAX_SIMULATIONS, moved=None, enough=None) -> Searched:
+            max_evaluations: int = MAX_SIMULATIONS, moved=None, enough=None,
+            lattice: int = LATTICE) -> Searched:
     """The coordinate search of the module's docstring on the lattice
-    ``clip(d0 + LATTICE * k, 0, 1)`` (scaled variables, integer ``k``).
+    ``clip(d0 + k / lattice, 0, 1)`` (scaled variables, integer ``k``).
 
     ``evaluate_many(designs, incumbent, ahead)`` gives the values of a list
     of designs (the caller may evaluate them in parallel, and start on
@@ -133,13 +140,14 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
     whose value is ``enough``. Every decision is a ``beats`` of two values,
     so the path depends on the values only through those decisions."""
     d0 = np.asarray(d0, float)
-    lo, hi = -np.ceil(d0 / LATTICE).astype(int), np.ceil((1 - d0) / LATTICE).astype(int)
+    first = lattice // FIRST_STEP
+    lo, hi = -np.ceil(d0 * lattice).astype(int), np.ceil((1 - d0) * lattice).astype(int)
     seen: dict[tuple, object] = {(0,) * len(d0): value0}
     trials: list[Trial] = []
     trial_at: dict[tuple, Trial] = {}
 
     def point(k):
-        return np.clip(d0 + LATTICE * np.asarray(k), 0.0, 1.0)
+        return np.clip(d0 + np.asarray(k) / lattice, 0.0, 1.0)
 
     def step(k, i, units):
         moved_k = list(k)
@@ -194,7 +202,7 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
                     break
         return out
 
-    k, units, cut, any_move = (0,) * len(d0), FIRST_STEP, False, False
+    k, units, cut, any_move = (0,) * len(d0), first, False, False
 
     def sweeps():
         """Poll and extend until the step falls below one unit or the budget ends."""
@@ -216,8 +224,8 @@ def compass(evaluate_many, d0: np.ndarray, value0, beats, allowed=lambda d: True
                 # keep going that way, each step twice the last (up to the first
                 # step), two at a time: the pair is evaluated together
                 while True:
-                    e1 = min(2 * abs(ext), FIRST_STEP) * (1 if ext > 0 else -1)
-                    e2 = min(2 * abs(e1), FIRST_STEP) * (1 if ext > 0 else -1)
+                    e1 = min(2 * abs(ext), first) * (1 if ext > 0 else -1)
+                    e2 = min(2 * abs(e1), first) * (1 if ext > 0 else -1)
                     a = step(k, i, e1)
                     if not valid(a, k):
                         break
@@ -258,7 +266,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     depend on how many. ``settings.max_simulations`` designs evaluated end
     the search."""
     t0 = time.perf_counter()
-    max_simulations = settings.max_simulations
+    max_simulations, unit = settings.max_simulations, 1 / settings.lattice
     profile = Profile()
     say = progress or (lambda message: None)
     population = population_of(space)
@@ -282,25 +290,26 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             origin, first = started.d, started
     names = [v.name for v in population.space.variables]
     say(f"baseline: hold {baseline.hold:.4f} s, peak finger force {baseline.peak:.2f} N "
-        f"(cap {caps_text(caps)}); pattern search, steps of {FIRST_STEP * LATTICE:g} to "
-        f"{LATTICE:g} of each box")
+        f"(cap {caps_text(caps)}); pattern search, steps of {1 / FIRST_STEP:g} to "
+        f"{unit:g} of each box")
 
     def moved(trial: Trial, count: int):
         line = f"{rate_of(trial.value):.1f} birds/min, " \
             if settings.objective == "throughput" else ""
-        say(f"step {abs(trial.units) * LATTICE:g}: {names[trial.variable]} "
+        say(f"step {abs(trial.units) * unit:g}: {names[trial.variable]} "
             f"{'up' if trial.units > 0 else 'down'} -> {line}hold {trial.value.hold:.4f} s, "
             f"peak {trial.value.peak:.2f} N ({count} designs evaluated)")
 
     with pool:
-        found = compass(scenes.score, origin, first, beats, allowed, max_simulations, moved)
+        found = compass(scenes.score, origin, first, beats, allowed, max_simulations, moved,
+                        lattice=settings.lattice)
     out = Outcome(found.value, baseline, caps, profile=profile)
     source = (f"the pattern search's simulation (rtol {settings.simulator.rtol:g}, steps up "
               f"to the grid's)")
     out.claims = [(m.hold, source) for m in found.value.members]
     out.claim = found.value.hold, source
     out.iterations = [{
-        "iteration": n + 1, "radius": abs(t.units) * LATTICE, "move": t.move,
+        "iteration": n + 1, "radius": abs(t.units) * unit, "move": t.move,
         "variable": names[t.variable], "direction": int(np.sign(t.units)),
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
@@ -314,7 +323,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             "line_rate_per_min": rate_of(t.value), "keeps_limits": t.value.within(caps),
             "jammed_birds": t.value.shortfall(caps)[1]})}
         for n, t in enumerate(found.trials)]
-    out.search = {"method": "pattern", "lattice": LATTICE, "first_step": FIRST_STEP * LATTICE,
+    out.search = {"method": "pattern", "lattice": unit, "first_step": 1 / FIRST_STEP,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
                   "simulations": len(found.trials) + 1 + (start is not None) - len(scenes.repeats),
                   "same_runs": len(scenes.repeats),

@@ -105,6 +105,9 @@ class LoopSettings:
     method: str = "trust-region"
     #: the pattern search's budget: designs simulated (each for every bird)
     max_simulations: int = 150
+    #: the pattern search's lattice: each variable's box in this many units
+    #: (its finest step; a power of two from 8)
+    lattice: int = 64
     #: ``hold`` (the longest hold) or ``throughput`` (the highest line rate
     #: with every bird held ``min_hold`` s: design/solvers/optimize/line.py)
     objective: str = "hold"
