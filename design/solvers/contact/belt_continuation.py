@@ -53,14 +53,25 @@ EVENT_STEP = 1e-6
 #: contact mode's, which puts the surface a few micrometres elsewhere: the
 #: finger then grazes the bird, without force, until it is this far (m) inside
 GRAZE_DEPTH = 2e-5
-#: a path whose steps must be shorter than this share of it to converge has
-#: lost its equilibrium (a fold): the state is then found afresh ...
-STALL_STEP = 1e-7
-#: ... or this, continuing from the accepted state to an integrator's trial:
-#: the trial only has to tell that its step crosses a fold (its instant, if
-#: accepted, is solved again at STALL_STEP), and locating a fold costs two
-#: failed Newton solves per halving
-TRIAL_STALL_STEP = 1e-3
+
+
+class Pace(NamedTuple):
+    """How a path cuts a step Newton cannot take (to 1/``shrink`` of it),
+    and where it gives up: a path whose steps must be shorter than ``stall``
+    of it to converge has lost its equilibrium (a fold), and the state is
+    then found afresh."""
+
+    stall: float
+    shrink: float
+
+
+#: the accepted instant's pace: halving, a fold located to 1e-7 of the path
+COMMIT = Pace(1e-7, 2.0)
+#: an integrator's trial, continued from the accepted state: it only has to
+#: tell that its step crosses a fold (its instant, if accepted, is solved
+#: again at COMMIT's pace), and each cut of a step costs two failed Newton
+#: solves near a fold: cut to 1/16, given up at 1e-3
+TRIAL = Pace(1e-3, 16.0)
 #: the finger's modes that touch the bird, and those that touch the belt
 BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
 BELT_MODES = ("belt", "tip+belt", "interior+belt")
@@ -215,17 +226,17 @@ class BeltedContact:
         #: mode -> the Jacobian inverse at the latest root Newton found in it
         self._inverses: dict = {}
 
-    def continued(self, target: Belted, previous: Belted | None, stall: float = STALL_STEP
+    def continued(self, target: Belted, previous: Belted | None, pace: Pace = COMMIT
                   ) -> tuple[Belted | None, str]:
         """The state at ``target``'s bird, belt and laws, continued from
         ``previous`` (its mode and unknowns are ignored; lost where its path
-        stalls at a step of ``stall``), else afresh; the message says what
-        happened on the way."""
+        stalls at ``pace``), else afresh; the message says what happened on
+        the way."""
         self.newton_iterations = 0
         self.lost = False
         state, msg = None, ""
         if previous is not None and (target.bird is not None or previous.bird is None):
-            state, msg = self._follow(previous, target, stall)
+            state, msg = self._follow(previous, target, pace)
         if state is not None:
             return state, msg
         fresh, msg2 = self._follow(self.free(target), target)
@@ -266,11 +277,11 @@ class BeltedContact:
         return replace(state, bird=bird, friction=p[nb:nb + nf],
                        plane=Plane.from_params(p[nb + nf:nb + nf + nd]), belt=p[nb + nf + nd:])
 
-    def _follow(self, state: Belted, target: Belted, stall: float = STALL_STEP
+    def _follow(self, state: Belted, target: Belted, pace: Pace = COMMIT
                 ) -> tuple[Belted | None, str]:
         """Continue ``state`` to ``target``: the usual short step, geometry and
         friction in one solve; else the geometry under the state's own
-        friction (lost where it stalls at a step of ``stall``), then the
+        friction (lost where it stalls at ``pace``), then the
         friction (where the equilibrium ends before, a fold, the contact
         sticks at the last one: ``held`` < 1)."""
         if state.bird is None and target.bird is not None:
@@ -284,21 +295,21 @@ class BeltedContact:
             # a contact starts inside the step: located on the whole step's path
             # (the two stages below are for a step Newton cannot take)
             located, _ = self._path(state, self._params(whole), exact=True,
-                                    h=self._to_event(state, new, 1.0), stall=stall)
+                                    h=self._to_event(state, new, 1.0), pace=pace)
             if located is not None:
                 return located, ""
         geometry = replace(state, bird=target.bird, plane=target.plane)
-        state, msg = self._path(state, self._params(geometry), exact=True, stall=stall)
+        state, msg = self._path(state, self._params(geometry), exact=True, pace=pace)
         if state is None:
             return None, msg
         laws = replace(state, friction=target.friction, belt=target.belt)
         return self._path(state, self._params(laws), exact=False)
 
     def _path(self, state: Belted, end: np.ndarray, exact: bool, h: float = 1.0,
-              stall: float = STALL_STEP) -> tuple[Belted | None, str]:
+              pace: Pace = COMMIT) -> tuple[Belted | None, str]:
         """From ``state`` to the parameters ``end`` in adaptive steps (the
-        first ``h`` of the way), with contact events, stalled where a step
-        of ``stall`` does not converge. ``exact`` false: stop at the last
+        first ``h`` of the way), with contact events, a step Newton cannot
+        take cut and the path stalled at ``pace``. ``exact`` false: stop at the last
         equilibrium before a fold (``held`` the share carried)."""
         start = self._params(state)
         if np.array_equal(start, end):
@@ -320,8 +331,8 @@ class BeltedContact:
             if isinstance(new, tuple):
                 h = self._to_event(state, new, h)
                 continue
-            h /= 2
-            if h < stall:
+            h /= pace.shrink
+            if h < pace.stall:
                 if exact:
                     return None, f"continuation stalled at {t:.6f} of the step"
                 return replace(state, held=t), ""

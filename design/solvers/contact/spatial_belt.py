@@ -16,9 +16,9 @@ import numpy as np
 from design.physics.rod import quaternion_rotation
 from design.solvers.beam.collocation import legendre_tables
 from design.solvers.beam.rod import N_STATE
-from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES,
-                                                    STALL_STEP, TRIAL_STALL_STEP, Belted,
-                                                    BeltedContact, Deepest, Plane, deepest)
+from design.solvers.contact.belt_continuation import (BELT_MODES, BIRD_MODES, COMMIT, TRIAL,
+                                                    Belted, BeltedContact, Deepest, Plane,
+                                                    deepest)
 from design.solvers.contact.robust import BASE_FRACTION
 from design.solvers.contact.spatial import (NO_FRICTION, FrictionLaw, Quadric, SpatialContact,
                                           SpatialSolution, SpatialState, grazing_shift,
@@ -74,7 +74,7 @@ class SpatialBeltContact(BeltedContact):
             return self._failed("the finger base is inside the object: invalid pose"), None
         target = Belted("free", None, None if quadric is None else quadric.params,
                         FrictionLaw.of(friction).params, plane, FrictionLaw.of(belt).params)
-        state, msg = self.continued(target, previous, TRIAL_STALL_STEP if trial else STALL_STEP)
+        state, msg = self.continued(target, previous, TRIAL if trial else COMMIT)
         if state is None:
             return self._failed(msg), None
         sol = self._solution(state, msg)
