@@ -3,15 +3,19 @@
 current design's run never reached has that run, record for record, and
 the search scores it so without simulating it."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
 from design.solvers.grasp.fingers import clear_at
 from design.solvers.grasp.simulation import SPATIAL_NODES, simulate_grasp
-from design.solvers.optimize.pattern_search import LATTICE
+from design.solvers.optimize import pattern_search
+from design.solvers.optimize.pattern_search import LATTICE, search
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.scenes import Scenes, same_run
-from design.solvers.optimize.trust_region import LOOP_SIMULATOR, Evaluated, Scored
+from design.solvers.optimize.trust_region import (LOOP_SIMULATOR, Evaluated, LoopSettings,
+                                                   Scored)
 from tests.test_spatial_nlp import placed_space
 
 
@@ -76,3 +80,20 @@ def test_a_design_that_moves_only_unreached_fingers_has_the_same_run(placed):
                   moved(space, reference.d, "groups.lower.stiffness_scale", 1),
                   moved(space, reference.d, "conveyor.rate", 1)):
         assert not same_run(population, other, reference)
+
+
+def test_the_search_walks_the_lattice_its_settings_name(placed, monkeypatch):
+    """Every design run as the baseline (no step beats it): on a lattice of
+    8 units the search polls each variable at 1/8 of its box and ends, a
+    lattice optimum; on the default lattice it halves that step down to
+    1/64 before it ends."""
+    space, population, reference = placed
+    monkeypatch.setattr(pattern_search, "simulate", lambda space, d, *args, **kwargs:
+                        Evaluated(np.asarray(d, float), reference.members[0].run))
+    for lattice in (8, LATTICE):
+        settings = replace(LoopSettings(), method="pattern", lattice=lattice,
+                           simulator=LOOP_SIMULATOR)
+        out = search(population, reference.peak + 1.0, settings, workers=1)
+        radii = sorted({h["radius"] for h in out.iterations}, reverse=True)
+        assert radii == [1 / n for n in (8, 16, 32, 64) if n <= lattice]
+        assert out.search["lattice"] == 1 / lattice and out.search["lattice_optimum"]
