@@ -35,6 +35,12 @@ def test_the_pattern_searchs_lattice_is_the_problems_or_64():
     assert design.check(problem(solver={**solver, "lattice": 16})).value.settings.lattice == 16
 
 
+def test_the_pattern_searchs_survey_is_the_problems_or_none():
+    solver = {"method": "pattern", "time_step": 0.005}
+    assert design.check(problem(solver=solver)).value.settings.survey == 0
+    assert design.check(problem(solver={**solver, "survey": 8})).value.settings.survey == 8
+
+
 def test_units_and_caps_are_read_in_si():
     p = design.check(problem(variables={"fingers.4.angle": ["100 deg", "120 deg"],
                                         "conveyor.rate": ["50 cm/s^2", "3 m/s^2"]},
@@ -65,6 +71,11 @@ def test_units_and_caps_are_read_in_si():
     ({"solver": {"time_step": 2}}, "solver.time_step", "outside the accepted range"),
     ({"solver": {"lattice": 48}}, "solver.lattice", "48 is not a power of two"),
     ({"solver": {"lattice": 4}}, "solver.lattice", "outside the accepted range"),
+    ({"solver": {"method": "pattern", "survey": 12}}, "solver.survey",
+     "12 is not a power of two"),
+    ({"solver": {"survey": 8}}, "solver.survey", "a survey needs solver.method: pattern"),
+    ({"solver": {"method": "pattern", "survey": 16, "max_simulations": 16}}, "solver.survey",
+     "16 Sobol points leave nothing of the budget of 16"),
     ({"solver": {"method": "simplex"}}, "solver.method",
      "'simplex' is not one of: trust-region, pattern"),
     ({"scene": "no_such_scene.yaml"}, "scene", "cannot find"),

@@ -11,7 +11,9 @@ import numpy as np
 import pytest
 
 from design.solvers.optimize import pattern_search, trust_region
-from design.solvers.optimize.pattern_search import FIRST_STEP, LATTICE, Pairs, compass
+from design.solvers.optimize.multistart import starting_designs
+from design.solvers.optimize.pattern_search import (FIRST_STEP, LATTICE, SURVEY_SEED, Pairs,
+                                                    compass, survey)
 
 UNIT = 1 / LATTICE
 from design.solvers.optimize.scenes import Scenes
@@ -396,3 +398,63 @@ def test_a_belt_that_does_not_slow_has_no_start_or_rate_to_act():
     assert len({space.scene_key(d) for d in slowing}) == 3
     c = space.setup(slowing[1]).conveyor
     assert c.velocity(1.3, c.start_time)[0] < v
+
+
+def two_hills(d):
+    """A narrow low hill at the box's centre and a wide higher one near a
+    corner: a coordinate search from the centre ends on the low one."""
+    d = np.asarray(d, float)
+    near, far = np.full(4, 0.5), np.array([0.85, 0.15, 0.8, 0.2])
+    return max(1.0 - 8 * float(np.sum((d - near) ** 2)), 1.5 - 2 * float(np.sum((d - far) ** 2)))
+
+
+def test_the_survey_starts_the_search_on_the_higher_hill():
+    """The survey simulates the first points of the multistart's Sobol
+    sequence together (its eight points begin with the multistart's seven)
+    and the search starts from the best that beats the baseline: from the
+    centre alone the search ends on the low hill, from the survey's best on
+    the high one."""
+    d0 = np.full(4, 0.5)
+    asked = []
+
+    def score(designs, incumbent):
+        asked.append((len(designs), incumbent))
+        return [two_hills(d) for d in designs]
+
+    def beats(a, b):
+        return a > b + 1e-6
+    trials = survey(score, d0, two_hills(d0), beats, lambda d: True, 8)
+    points = starting_designs(d0, 9, SURVEY_SEED)[1:]
+    assert asked == [(8, two_hills(d0))]
+    assert all(np.array_equal(t.d, p) for t, p in zip(trials, points)) and len(trials) == 8
+    assert all(np.array_equal(a, b) for a, b in zip(points, starting_designs(d0, 8, 0)[1:]))
+    taken = [t for t in trials if t.taken]
+    assert len(taken) == 1 and taken[0].value == max(t.value for t in trials)
+    assert all(t.move == "survey" and t.variable is None for t in trials)
+
+    def search_from(start):
+        return compass(lambda ds, incumbent, ahead: [two_hills(d) for d in ds], start,
+                       two_hills(start), beats)
+    alone, surveyed = search_from(d0), search_from(taken[0].d)
+    assert alone.value == pytest.approx(1.0, abs=1e-3)
+    assert surveyed.value == pytest.approx(1.5, abs=1e-3)
+
+
+def test_the_survey_takes_the_first_of_equals_and_nothing_that_does_not_beat():
+    """Two surveyed points equal within the band: the first is taken; no
+    point beating the baseline: none is, and the search starts from the
+    baseline; a point breaking a design rule is not simulated."""
+    d0 = np.full(4, 0.5)
+    values = [0.2, 0.7, 0.3, 0.7 + 1e-9, 0.1, 0.0, 0.6, 0.5]
+
+    def beats(a, b):
+        return a > b + 1e-6
+
+    def score(designs, incumbent):
+        return values[:len(designs)]
+    trials = survey(score, d0, 0.4, beats, lambda d: True, 8)
+    assert [t.taken for t in trials] == [n == 1 for n in range(8)]
+    assert not any(t.taken for t in survey(score, d0, 0.7, beats, lambda d: True, 8))
+    points = starting_designs(d0, 9, SURVEY_SEED)[1:]
+    kept = survey(score, d0, 0.4, beats, lambda d: d[0] < 0.5, 8)
+    assert [t.d.tolist() for t in kept] == [p.tolist() for p in points if p[0] < 0.5]

@@ -5,6 +5,7 @@ result.json says."""
 from __future__ import annotations
 
 import base64
+import html
 import json
 from html.parser import HTMLParser
 from pathlib import Path
@@ -354,3 +355,32 @@ def test_the_search_table_says_where_and_why_a_candidate_s_run_ended():
     assert r.column("history-table", "simulated peak (N)") == ["19.1", "—", "18.2"]
     assert r.column("history-table", "ruled out by") == [
         "", "finger 5b pressed 19.70 N, over its limit 19.60 N, at 1.143 s", "its whole run"]
+
+
+def test_the_search_table_says_which_surveyed_design_the_search_started_from():
+    """Two surveyed designs, the second taken, then a poll: the text names
+    the survey and the simulation the search started from; the survey's
+    rows have no step."""
+    from design.report.design import search_table
+    from design.report.page import Page
+    survey = {"radius": 0.0, "variable": None, "move": "survey", "ruled_out_by": None,
+              "stopped": None, "simulated_peak_force_N": 18.0}
+    solver = {"search": {"rtol": 1e-6, "first_step": 0.125, "lattice": 1 / 32,
+                         "hold_band_s": 1e-4, "simulations": 4, "max_simulations": 4,
+                         "lattice_optimum": False, "bird_simulations": 4, "survey": 2},
+              "history": [
+                  {"iteration": 1, **survey, "simulated_hold_time_s": 0.30, "accepted": False},
+                  {"iteration": 2, **survey, "simulated_hold_time_s": 0.50, "accepted": True},
+                  {"iteration": 3, "radius": 0.125, "variable": "conveyor.rate",
+                   "move": "poll", "simulated_hold_time_s": 0.52, "simulated_peak_force_N": 18.5,
+                   "accepted": True, "ruled_out_by": None, "stopped": None}]}
+    page = Page("search")
+    search_table(page, solver)
+    rendered = page.render()
+    text = html.unescape(rendered)
+    assert "first a survey of 2 points of a scrambled Sobol sequence" in text
+    assert "starting from the best of them (simulation 2)" in text
+    assert "the survey's included, the budget ending the search" in text
+    r = Report(rendered)
+    assert r.column("history-table", "step (scaled)") == ["—", "—", "0.125"]
+    assert r.column("history-table", "move") == ["survey", "survey", "poll"]

@@ -3,6 +3,7 @@
 current design's run never reached has that run, record for record, and
 the search scores it so without simulating it."""
 
+import copy
 from dataclasses import replace
 
 import numpy as np
@@ -11,6 +12,7 @@ import pytest
 from design.solvers.grasp.fingers import clear_at
 from design.solvers.grasp.simulation import SPATIAL_NODES, simulate_grasp
 from design.solvers.optimize import pattern_search
+from design.solvers.optimize.multistart import starting_designs
 from design.solvers.optimize.pattern_search import LATTICE, search
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.scenes import Scenes, same_run
@@ -97,3 +99,39 @@ def test_the_search_walks_the_lattice_its_settings_name(placed, monkeypatch):
         radii = sorted({h["radius"] for h in out.iterations}, reverse=True)
         assert radii == [1 / n for n in (8, 16, 32, 64) if n <= lattice]
         assert out.search["lattice"] == 1 / lattice and out.search["lattice_optimum"]
+
+
+def test_a_survey_starts_the_search_at_its_best_point_within_the_budget(placed, monkeypatch):
+    """A hold that grows towards the point of the box opposite the
+    baseline: the search first simulates the survey's eight Sobol points,
+    then polls around the best of them, the survey counted in its budget;
+    started from a given design it surveys nothing."""
+    space, population, reference = placed
+    d0 = space.scale(space.base_values)
+    corner = 1 - d0
+
+    def run(space, d, *args, **kwargs):
+        d = np.asarray(d, float)
+        held = copy.copy(reference.members[0].run)
+        held.__dict__["summary"] = {**held.summary, "jam": [], "hold_time_s":
+                                    reference.hold + 0.1 - 0.01 * float(np.sum((d - corner) ** 2))}
+        return Evaluated(d, held)
+    monkeypatch.setattr(pattern_search, "simulate", run)
+    settings = replace(LoopSettings(), method="pattern", lattice=8, survey=8, max_simulations=20,
+                       simulator=LOOP_SIMULATOR)
+    out = search(population, reference.peak + 1.0, settings, workers=1)
+    points = starting_designs(d0, 9, 0)[1:]
+    rows = out.iterations
+    assert [h["move"] for h in rows[:8]] == ["survey"] * 8
+    assert all(np.array_equal(h["candidate_scaled"], p) for h, p in zip(rows, points))
+    holds = [h["simulated_hold_time_s"] for h in rows[:8]]
+    best = int(np.argmax(holds))
+    assert [h["accepted"] for h in rows[:8]] == [n == best for n in range(8)]
+    first_poll = np.array(rows[8]["candidate_scaled"]) - points[best]
+    assert np.count_nonzero(np.abs(first_poll) > 1e-12) == 1
+    assert np.max(np.abs(first_poll)) == pytest.approx(1 / 8)
+    assert out.search["survey"] == 8 and out.search["simulations"] == 20
+    assert not out.search["lattice_optimum"] and out.best.hold > holds[best]
+    started = search(population, reference.peak + 1.0, settings, start=d0, workers=1)
+    assert "survey" not in {h["move"] for h in started.iterations}
+    assert started.search["survey"] == 0

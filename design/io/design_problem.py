@@ -34,7 +34,10 @@ bounds, the bruise cap, the design rules and the solver settings.
                                # max_simulations: designs evaluated (150), lattice:
                                # each box in this many units, the finest step (64;
                                # a power of two from 8 to 1024: a coarser lattice
-                               # ends the search sooner, on a coarser point)
+                               # ends the search sooner, on a coarser point),
+                               # survey: Sobol points of the box simulated first, the
+                               # search starting from the best of them and the
+                               # baseline (0; a power of two, counted in the budget)
 
 Variable names: ``fingers.<name>.angle|phi_x|phi_y|length|height``,
 ``groups.<group>.stiffness_scale``, ``conveyor.speed|start_time|rate|final_speed``,
@@ -422,12 +425,31 @@ def _rules(reader: Reader, value: object) -> Rules | None:
 
 #: a design problem's integer solver options: [lowest, highest]
 SOLVER_INTEGERS = {"beam_intervals": (2, 32), "max_iter": (1, 10000), "outer_iterations": (0, 100),
-                   "max_simulations": (1, 10000), "lattice": (8, 1024)}
+                   "max_simulations": (1, 10000), "lattice": (8, 1024), "survey": (0, 1024)}
 #: its other numeric solver options: dimension, lowest, highest, lowest excluded
 SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
                      "tolerance": ("dimensionless", 1e-12, 1e-2, False),
                      "trust_region": ("dimensionless", 0.0, 1.0, True),
                      "cap_margin": ("dimensionless", 0.0, 0.9, False)}
+
+
+def _survey(reader: Reader, stated: dict) -> int | None:
+    """The pattern search's survey, ``stated["survey"]`` Sobol points: a power
+    of two (the sequence's balanced prefixes), fewer than the search's budget,
+    and only for the pattern search."""
+    survey, budget = stated["survey"], stated.get("max_simulations",
+                                                  LoopSettings.max_simulations)
+    where = join("solver", "survey")
+    if survey & (survey - 1):
+        reader.add(where, f"{survey} is not a power of two (1, 2, 4, ... 1024) or 0")
+    elif stated.get("method", LoopSettings.method) != "pattern":
+        reader.add(where, "a survey needs solver.method: pattern")
+    elif budget is not None and survey >= budget:
+        reader.add(where, f"{survey} Sobol points leave nothing of the budget of {budget} "
+                          "designs (solver.max_simulations)")
+    else:
+        return survey
+    return None
 
 
 def _solver(reader: Reader, value: object) -> dict | None:
@@ -448,6 +470,8 @@ def _solver(reader: Reader, value: object) -> dict | None:
         stated["lattice"] = None
     if "method" in spec:
         stated["method"] = reader.choice(spec, "method", "solver", LOOP_METHODS)
+    if stated.get("survey"):
+        stated["survey"] = _survey(reader, stated)
     if "ipopt" in spec:
         if not isinstance(spec["ipopt"], Mapping):
             reader.add(join("solver", "ipopt"), "expected a mapping of Ipopt options")

@@ -148,7 +148,15 @@ def search_table(page: Page, solver: dict) -> None:
         return
     ruled = any(h.get("ruled_out_by") for h in solver["history"])
     birds = any("simulated_hold_times_s" in h for h in solver["history"])
-    page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): steps from "
+    surveyed = [h for h in solver["history"] if h["move"] == "survey"]
+    chosen = next((h for h in surveyed if h["accepted"]), None)
+    page.text(f"Pattern search on the simulator (rtol {s['rtol']:g}): "
+              + (f"first a survey of {len(surveyed)} points of a scrambled Sobol sequence in "
+                 "the box, the search starting from "
+                 + (f"the best of them (simulation {chosen['iteration']})" if chosen else
+                    "the baseline (none of them beats it)") + "; then "
+                 if surveyed else "")
+              + f"steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "
               f"taken when it lengthens the hold by more than {s['hold_band_s'] * 1e3:g} ms "
               f"with every finger under the cap; {s['simulations']} designs simulated, the "
@@ -158,6 +166,7 @@ def search_table(page: Page, solver: dict) -> None:
                  "finger the run never reached adds nothing to it)"
                  if s.get("same_runs") else "")
               + f", on a budget of {s['max_simulations']} designs from the start"
+              + (", the survey's included" if surveyed else "")
               + ("" if s["lattice_optimum"] else ", the budget ending the search") + "."
               + ((f" {s['bird_simulations']} bird simulations: a candidate's birds are "
                   "simulated until one shows" if birds else " A candidate's run ends as soon "
@@ -171,7 +180,8 @@ def search_table(page: Page, solver: dict) -> None:
             return ""
         return (f"{h['ruled_out_by']}: " if birds else "") + (h.get("stopped")
                                                               or "its whole run")
-    page.table([{"simulation": h["iteration"], "step (scaled)": h["radius"],
+    page.table([{"simulation": h["iteration"],
+                 "step (scaled)": None if h["move"] == "survey" else h["radius"],
                  "variable": h["variable"], "move": h["move"],
                  "simulated hold (s)": None if h.get("stopped") else h["simulated_hold_time_s"],
                  "simulated peak (N)": None if h.get("stopped") else h["simulated_peak_force_N"],

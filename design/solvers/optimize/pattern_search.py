@@ -11,6 +11,12 @@ integer ``k`` (scaled variables; ``n`` = 64 unless the problem states its
 ``lattice``), so two runs can differ only where a comparison of two
 simulated holds or of a peak with the cap flips:
 
+* where the problem asks for a survey (``solver.survey``), the search first
+  simulates that many points of a scrambled Sobol sequence in the box
+  (seed 0: a multistart's starts are its first points), together, and
+  starts from the best of them that beats the baseline (the first of
+  equals), else from the baseline: a local search from the baseline alone
+  ends on the optimum nearest it, and the hold has many;
 * a coordinate search with a step of ``n / 8`` lattice units (1/8 of each
   box), halved down to one unit: for each variable in the problem's order it simulates one
   step up and one down; the better of the two (up on a tie) is taken if it
@@ -74,6 +80,7 @@ from design.solvers.grasp.cutoff import Cutoff
 from design.solvers.optimize.ahead import Ahead
 from design.solvers.optimize.forked import processes
 from design.solvers.optimize.line import faster, rate_of
+from design.solvers.optimize.multistart import starting_designs
 from design.solvers.optimize.population import Population
 from design.solvers.optimize.profile import SIMULATIONS, Profile
 from design.solvers.optimize.scenes import Scenes, same_run
@@ -90,6 +97,9 @@ from design.solvers.optimize.variables import DesignSpace
 LATTICE = LoopSettings.lattice
 #: the first step is 1/FIRST_STEP of each box
 FIRST_STEP = 8
+#: the survey's Sobol seed: a multistart's default (its starts are the
+#: survey's first points)
+SURVEY_SEED = 0
 #: the polls whose points may run ahead on a free core
 AHEAD_POLLS = 3
 #: a move must lengthen the hold by more than this (s)
@@ -102,11 +112,12 @@ MAX_SIMULATIONS = LoopSettings.max_simulations
 class Trial:
     """One evaluated lattice point: its scaled design, its value, and the
     move that reached it (variable index, step in lattice units, ``poll`` or
-    ``extend``) and whether the search took it."""
+    ``extend``; a survey's point: no variable, no step, ``survey``) and
+    whether the search took it (a survey's: started from it)."""
 
     d: np.ndarray
     value: object
-    variable: int
+    variable: int | None
     units: int
     move: str
     taken: bool = False
@@ -258,13 +269,15 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
            rules: Rules = Rules(), start=None, progress=None, anchor: bool = True,
            workers: int | None = None) -> Outcome:
     """Maximise the (population's) hold under the cap (N; one per bird, or one
-    for all) from ``start`` (scaled; the baseline by default; with ``anchor``
-    a start worse than the baseline gives way to it) by :func:`compass`. A
-    point that breaks a design rule the baseline keeps is not tried. The
-    points evaluated together are simulated by ``workers`` processes (by
-    default one per core, at most two: :class:`Pairs`); the answer does not
-    depend on how many. ``settings.max_simulations`` designs evaluated end
-    the search."""
+    for all) by :func:`compass` from ``start`` (scaled; with ``anchor`` a
+    start worse than the baseline gives way to it); by default from the
+    baseline, or with ``settings.survey`` from the best of the baseline and
+    the :func:`survey`'s points. A point that breaks a design rule the
+    baseline keeps is not tried. The points evaluated together are simulated
+    by ``workers`` processes (by default one per core, at most two:
+    :class:`Pairs`); the answer does not depend on how many.
+    ``settings.max_simulations`` designs evaluated (the survey's among them)
+    end the search."""
     t0 = time.perf_counter()
     max_simulations, unit = settings.max_simulations, 1 / settings.lattice
     profile = Profile()
@@ -301,8 +314,17 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
             f"peak {trial.value.peak:.2f} N ({count} designs evaluated)")
 
     with pool:
-        found = compass(scenes.score, origin, first, beats, allowed, max_simulations, moved,
-                        lattice=settings.lattice)
+        surveyed = survey(scenes.score, d0, baseline, beats, allowed, settings.survey) \
+            if start is None and settings.survey else []
+        chosen = next((t for t in surveyed if t.taken), None)
+        if chosen:
+            origin, first = chosen.d, chosen.value
+        if surveyed:
+            say(f"survey: {len(surveyed)} Sobol points of the box; "
+                + (f"starting from the best, hold {first.hold:.4f} s, peak {first.peak:.2f} N"
+                   if chosen else "none beats the baseline"))
+        found = compass(scenes.score, origin, first, beats, allowed,
+                        max_simulations - len(surveyed), moved, lattice=settings.lattice)
     out = Outcome(found.value, baseline, caps, profile=profile)
     source = (f"the pattern search's simulation (rtol {settings.simulator.rtol:g}, steps up "
               f"to the grid's)")
@@ -310,7 +332,8 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     out.claim = found.value.hold, source
     out.iterations = [{
         "iteration": n + 1, "radius": abs(t.units) * unit, "move": t.move,
-        "variable": names[t.variable], "direction": int(np.sign(t.units)),
+        "variable": None if t.variable is None else names[t.variable],
+        "direction": int(np.sign(t.units)),
         "candidate_scaled": t.d.tolist(), "simulated_hold_time_s": t.value.hold,
         "simulated_peak_force_N": t.value.peak, "accepted": t.taken,
         "same_run": scenes.repeated(t.d),
@@ -322,19 +345,39 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         **({} if settings.objective != "throughput" else {
             "line_rate_per_min": rate_of(t.value), "keeps_limits": t.value.within(caps),
             "jammed_birds": t.value.shortfall(caps)[1]})}
-        for n, t in enumerate(found.trials)]
+        for n, t in enumerate(surveyed + found.trials)]
     out.search = {"method": "pattern", "lattice": unit, "first_step": 1 / FIRST_STEP,
                   "hold_band_s": HOLD_BAND, "rtol": settings.simulator.rtol,
-                  "simulations": len(found.trials) + 1 + (start is not None) - len(scenes.repeats),
+                  "simulations": len(surveyed) + len(found.trials) + 1 + (start is not None)
+                  - len(scenes.repeats), "survey": len(surveyed),
                   "same_runs": len(scenes.repeats),
                   "bird_simulations": pool.simulations,
                   "max_simulations": max_simulations, "lattice_optimum": found.lattice_optimum,
                   "processes": pool.processes, "runs_ahead": pool.ran_ahead,
                   "processes_cpu_time_s": pool.children_cpu_time,
                   "caps_N": caps_value(caps)}
-    out.trials = found.trials
+    out.trials = surveyed + found.trials
     out.wall_time = time.perf_counter() - t0
     return out
+
+
+def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int) -> list[Trial]:
+    """The first ``points`` points of the scrambled Sobol sequence in the
+    box (:func:`~design.solvers.optimize.multistart.starting_designs`' seed,
+    so a multistart's starts are its first points) that keep the design
+    rules, scored together by ``score(designs, incumbent)`` against the
+    ``baseline`` (scaled start ``d0``); the best one that ``beats`` it, the
+    first of equals, is marked taken: the search starts there."""
+    designs = [d for d in starting_designs(d0, points + 1, SURVEY_SEED)[1:] if allowed(d)]
+    trials = [Trial(d, value, None, 0, "survey")
+              for d, value in zip(designs, score(designs, baseline))]
+    best = None
+    for t in trials:
+        if beats(t.value, best.value if best else baseline):
+            best = t
+    if best:
+        best.taken = True
+    return trials
 
 
 def judges(population: Population, caps: np.ndarray, settings: LoopSettings):

@@ -20,7 +20,7 @@ from design.solvers.optimize.trust_region import LOOP_SIMULATOR, LoopSettings
 #: a design problem's ``solver`` keys (SI values), each optional
 SOLVER_KEYS = ("method", "time_step", "beam_intervals", "max_iter", "tolerance",
                "outer_iterations", "trust_region", "cap_margin", "max_simulations", "lattice",
-               "ipopt")
+               "survey", "ipopt")
 #: the design loops a problem may name: Ipopt's trust-region loop
 #: (design/solvers/optimize/trust_region.py) or the pattern search on the
 #: simulator (design/solvers/optimize/pattern_search.py)
@@ -56,4 +56,5 @@ def loop_settings(solver: Mapping, scene: GraspSettings) -> LoopSettings:
                         solver.get("cap_margin", d.cap_margin),
                         solver.get("method", d.method),
                         solver.get("max_simulations", d.max_simulations),
-                        lattice=solver.get("lattice", d.lattice))
+                        lattice=solver.get("lattice", d.lattice),
+                        survey=solver.get("survey", d.survey))

@@ -108,6 +108,11 @@ class LoopSettings:
     #: the pattern search's lattice: each variable's box in this many units
     #: (its finest step; a power of two from 8)
     lattice: int = 64
+    #: the pattern search's survey: from the baseline it first simulates
+    #: this many points of a scrambled Sobol sequence in the box and starts
+    #: from the best of them and the baseline (0: from the baseline; a
+    #: power of two)
+    survey: int = 0
     #: ``hold`` (the longest hold) or ``throughput`` (the highest line rate
     #: with every bird held ``min_hold`` s: design/solvers/optimize/line.py)
     objective: str = "hold"
