@@ -212,6 +212,7 @@ LINE = {"objective": "throughput", "min_hold": "0.2 s"}
     ({**LINE, "finger_sets": [3, 9]}, "finger_sets[1]"),      # eq. 5.4: at most 8
     ({**LINE, "finger_sets": [3, 3]}, "finger_sets"),
     ({**LINE, "solver": {}}, "solver.method"),
+    ({**LINE, "solver": {"method": "pattern", "survey": 8}}, "solver.survey"),
     ({**LINE, "min_hold": "2 s"}, "min_hold"),                # longer than the run
     ({**LINE, "objective": "speed"}, "objective")])
 def test_line_problems_refuse_bad_input_by_field(change, field):

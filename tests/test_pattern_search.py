@@ -4,6 +4,7 @@ keeps its budget and the allowed region, and its path does not move when
 the objective and the start move by round-off."""
 
 import os
+from collections import namedtuple
 from dataclasses import replace
 from types import SimpleNamespace
 
@@ -423,7 +424,7 @@ def test_the_survey_starts_the_search_on_the_higher_hill():
 
     def beats(a, b):
         return a > b + 1e-6
-    trials = survey(score, d0, two_hills(d0), beats, lambda d: True, 8)
+    trials = survey(score, d0, two_hills(d0), beats, lambda d: True, 8, hold=float)
     points = starting_designs(d0, 9, SURVEY_SEED)[1:]
     assert asked == [(8, two_hills(d0))]
     assert all(np.array_equal(t.d, p) for t, p in zip(trials, points)) and len(trials) == 8
@@ -452,9 +453,33 @@ def test_the_survey_takes_the_first_of_equals_and_nothing_that_does_not_beat():
 
     def score(designs, incumbent):
         return values[:len(designs)]
-    trials = survey(score, d0, 0.4, beats, lambda d: True, 8)
+    trials = survey(score, d0, 0.4, beats, lambda d: True, 8, hold=float)
     assert [t.taken for t in trials] == [n == 1 for n in range(8)]
-    assert not any(t.taken for t in survey(score, d0, 0.7, beats, lambda d: True, 8))
+    assert not any(t.taken for t in survey(score, d0, 0.7, beats, lambda d: True, 8,
+                                           hold=float))
     points = starting_designs(d0, 9, SURVEY_SEED)[1:]
-    kept = survey(score, d0, 0.4, beats, lambda d: d[0] < 0.5, 8)
+    kept = survey(score, d0, 0.4, beats, lambda d: d[0] < 0.5, 8, hold=float)
     assert [t.d.tolist() for t in kept] == [p.tolist() for p in points if p[0] < 0.5]
+
+
+def test_the_survey_does_not_start_from_a_design_that_keeps_the_limits_by_holding_less():
+    """A baseline over its limits (a jam) holding 0.48 s: a surveyed design
+    that keeps the limits by holding nothing beats it (the search's rule)
+    but is no start; one within the limits holding longer is, even after a
+    nearer-to-the-limits one that holds longer still."""
+    Value = namedtuple("Value", "hold within")
+
+    def beats(a, b):
+        if a.within != b.within:
+            return a.within
+        return a.hold > b.hold + 1e-4
+    baseline = Value(0.48, False)
+
+    def taken(values):
+        trials = survey(lambda designs, incumbent: values[:len(designs)], np.full(4, 0.5),
+                        baseline, beats, lambda d: True, len(values))
+        return [t.taken for t in trials]
+    idle, over, held = Value(0.0, True), Value(0.6, False), Value(0.55, True)
+    assert taken([idle, idle]) == [False, False]
+    assert taken([idle, over, held, idle]) == [False, False, True, False]
+    assert taken([idle, over]) == [False, True]

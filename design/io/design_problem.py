@@ -229,6 +229,8 @@ def _line(reader: Reader, data: dict, scene: GraspScene | None, solver: dict | N
         reader.add("cap", "a throughput problem takes one cap")
     if multistart is not None and multistart.starts > 1:
         reader.add("multistart", "a throughput problem starts from its baseline only")
+    if solver is not None and solver.get("survey"):
+        reader.add("solver.survey", "a throughput problem starts from its baseline only")
     sets: tuple[int, ...] = ()
     if "finger_sets" in data and scene is not None:
         top = max_sets(scene.grasper)

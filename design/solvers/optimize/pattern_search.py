@@ -14,9 +14,9 @@ simulated holds or of a peak with the cap flips:
 * where the problem asks for a survey (``solver.survey``), the search first
   simulates that many points of a scrambled Sobol sequence in the box
   (seed 0: a multistart's starts are its first points), together, and
-  starts from the best of them that beats the baseline (the first of
-  equals), else from the baseline: a local search from the baseline alone
-  ends on the optimum nearest it, and the hold has many;
+  starts from the best of them that beats the baseline and holds longer
+  (the first of equals), else from the baseline: a local search from the
+  baseline alone ends on the optimum nearest it, and the hold has many;
 * a coordinate search with a step of ``n / 8`` lattice units (1/8 of each
   box), halved down to one unit: for each variable in the problem's order it simulates one
   step up and one down; the better of the two (up on a tie) is taken if it
@@ -361,19 +361,23 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     return out
 
 
-def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int) -> list[Trial]:
+def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int,
+           hold=lambda value: value.hold) -> list[Trial]:
     """The first ``points`` points of the scrambled Sobol sequence in the
     box (:func:`~design.solvers.optimize.multistart.starting_designs`' seed,
     so a multistart's starts are its first points) that keep the design
     rules, scored together by ``score(designs, incumbent)`` against the
-    ``baseline`` (scaled start ``d0``); the best one that ``beats`` it, the
-    first of equals, is marked taken: the search starts there."""
+    ``baseline`` (scaled start ``d0``). Of those that ``beat`` it and
+    ``hold`` longer than it by more than :data:`HOLD_BAND` (a design that
+    keeps limits the baseline breaks by holding nothing is no start), the
+    best, the first of equals, is marked taken: the search starts there."""
     designs = [d for d in starting_designs(d0, points + 1, SURVEY_SEED)[1:] if allowed(d)]
     trials = [Trial(d, value, None, 0, "survey")
               for d, value in zip(designs, score(designs, baseline))]
     best = None
     for t in trials:
-        if beats(t.value, best.value if best else baseline):
+        if beats(t.value, baseline) and hold(t.value) > hold(baseline) + HOLD_BAND and \
+                (best is None or beats(t.value, best.value)):
             best = t
     if best:
         best.taken = True
