@@ -154,7 +154,7 @@ def search_table(page: Page, solver: dict) -> None:
               + (f"first a survey of {len(surveyed)} points of a scrambled Sobol sequence in "
                  "the box, the search starting from "
                  + (f"the best of them (simulation {chosen['iteration']})" if chosen else
-                    "the baseline (none of them beats it)") + "; then "
+                    "the baseline (none of them beats it with a longer hold)") + "; then "
                  if surveyed else "")
               + f"steps from "
               f"{s['first_step']:g} down to {s['lattice']:g} of each variable's box, a move "

@@ -322,7 +322,7 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
         if surveyed:
             say(f"survey: {len(surveyed)} Sobol points of the box; "
                 + (f"starting from the best, hold {first.hold:.4f} s, peak {first.peak:.2f} N"
-                   if chosen else "none beats the baseline"))
+                   if chosen else "none beats the baseline with a longer hold"))
         found = compass(scenes.score, origin, first, beats, allowed,
                         max_simulations - len(surveyed), moved, lattice=settings.lattice)
     out = Outcome(found.value, baseline, caps, profile=profile)
