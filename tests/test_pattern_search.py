@@ -401,6 +401,18 @@ def test_a_belt_that_does_not_slow_has_no_start_or_rate_to_act():
     assert c.velocity(1.3, c.start_time)[0] < v
 
 
+#: a surveyed design's value: its hold (s) and whether it keeps its limits
+Held = namedtuple("Held", "hold within", defaults=(True,))
+
+
+def held_beats(a: Held, b: Held) -> bool:
+    """The search's rule on :class:`Held` values: keeping the limits first,
+    then a hold longer by more than a band."""
+    if a.within != b.within:
+        return a.within
+    return a.hold > b.hold + 1e-6
+
+
 def two_hills(d):
     """A narrow low hill at the box's centre and a wide higher one near a
     corner: a coordinate search from the centre ends on the low one."""
@@ -420,22 +432,19 @@ def test_the_survey_starts_the_search_on_the_higher_hill():
 
     def score(designs, incumbent):
         asked.append((len(designs), incumbent))
-        return [two_hills(d) for d in designs]
-
-    def beats(a, b):
-        return a > b + 1e-6
-    trials = survey(score, d0, two_hills(d0), beats, lambda d: True, 8, hold=float)
+        return [Held(two_hills(d)) for d in designs]
+    trials = survey(score, d0, Held(two_hills(d0)), held_beats, lambda d: True, 8)
     points = starting_designs(d0, 9, SURVEY_SEED)[1:]
-    assert asked == [(8, two_hills(d0))]
+    assert asked == [(8, Held(two_hills(d0)))]
     assert all(np.array_equal(t.d, p) for t, p in zip(trials, points)) and len(trials) == 8
     assert all(np.array_equal(a, b) for a, b in zip(points, starting_designs(d0, 8, 0)[1:]))
     taken = [t for t in trials if t.taken]
-    assert len(taken) == 1 and taken[0].value == max(t.value for t in trials)
+    assert len(taken) == 1 and taken[0].value.hold == max(t.value.hold for t in trials)
     assert all(t.move == "survey" and t.variable is None for t in trials)
 
     def search_from(start):
         return compass(lambda ds, incumbent, ahead: [two_hills(d) for d in ds], start,
-                       two_hills(start), beats)
+                       two_hills(start), lambda a, b: a > b + 1e-6)
     alone, surveyed = search_from(d0), search_from(taken[0].d)
     assert alone.value == pytest.approx(1.0, abs=1e-3)
     assert surveyed.value == pytest.approx(1.5, abs=1e-3)
@@ -446,19 +455,15 @@ def test_the_survey_takes_the_first_of_equals_and_nothing_that_does_not_beat():
     point beating the baseline: none is, and the search starts from the
     baseline; a point breaking a design rule is not simulated."""
     d0 = np.full(4, 0.5)
-    values = [0.2, 0.7, 0.3, 0.7 + 1e-9, 0.1, 0.0, 0.6, 0.5]
-
-    def beats(a, b):
-        return a > b + 1e-6
+    values = [Held(h) for h in (0.2, 0.7, 0.3, 0.7 + 1e-9, 0.1, 0.0, 0.6, 0.5)]
 
     def score(designs, incumbent):
         return values[:len(designs)]
-    trials = survey(score, d0, 0.4, beats, lambda d: True, 8, hold=float)
+    trials = survey(score, d0, Held(0.4), held_beats, lambda d: True, 8)
     assert [t.taken for t in trials] == [n == 1 for n in range(8)]
-    assert not any(t.taken for t in survey(score, d0, 0.7, beats, lambda d: True, 8,
-                                           hold=float))
+    assert not any(t.taken for t in survey(score, d0, Held(0.7), held_beats, lambda d: True, 8))
     points = starting_designs(d0, 9, SURVEY_SEED)[1:]
-    kept = survey(score, d0, 0.4, beats, lambda d: d[0] < 0.5, 8, hold=float)
+    kept = survey(score, d0, Held(0.4), held_beats, lambda d: d[0] < 0.5, 8)
     assert [t.d.tolist() for t in kept] == [p.tolist() for p in points if p[0] < 0.5]
 
 
@@ -467,19 +472,13 @@ def test_the_survey_does_not_start_from_a_design_that_keeps_the_limits_by_holdin
     that keeps the limits by holding nothing beats it (the search's rule)
     but is no start; one within the limits holding longer is, even after a
     nearer-to-the-limits one that holds longer still."""
-    Value = namedtuple("Value", "hold within")
-
-    def beats(a, b):
-        if a.within != b.within:
-            return a.within
-        return a.hold > b.hold + 1e-4
-    baseline = Value(0.48, False)
+    baseline = Held(0.48, False)
 
     def taken(values):
         trials = survey(lambda designs, incumbent: values[:len(designs)], np.full(4, 0.5),
-                        baseline, beats, lambda d: True, len(values))
+                        baseline, held_beats, lambda d: True, len(values))
         return [t.taken for t in trials]
-    idle, over, held = Value(0.0, True), Value(0.6, False), Value(0.55, True)
+    idle, over, held = Held(0.0), Held(0.6, False), Held(0.55)
     assert taken([idle, idle]) == [False, False]
     assert taken([idle, over, held, idle]) == [False, False, True, False]
     assert taken([idle, over]) == [False, True]

@@ -435,6 +435,15 @@ SOLVER_QUANTITIES = {"time_step": ("time", 5e-4, 0.05, False),
                      "cap_margin": ("dimensionless", 0.0, 0.9, False)}
 
 
+def _power_of_two(reader: Reader, key: str, value: int, allowed: str) -> bool:
+    """Is solver option ``key``'s ``value`` a power of two? Where not, the
+    problem says so, naming the ``allowed`` values."""
+    if value & (value - 1):
+        reader.add(join("solver", key), f"{value} is not a power of two ({allowed})")
+        return False
+    return True
+
+
 def _survey(reader: Reader, stated: dict) -> int | None:
     """The pattern search's survey, ``stated["survey"]`` Sobol points: a power
     of two (the sequence's balanced prefixes), fewer than the search's budget,
@@ -442,16 +451,16 @@ def _survey(reader: Reader, stated: dict) -> int | None:
     survey, budget = stated["survey"], stated.get("max_simulations",
                                                   LoopSettings.max_simulations)
     where = join("solver", "survey")
-    if survey & (survey - 1):
-        reader.add(where, f"{survey} is not a power of two (1, 2, 4, ... 1024) or 0")
-    elif stated.get("method", LoopSettings.method) != "pattern":
+    if not _power_of_two(reader, "survey", survey, "1, 2, 4, ... 1024, or 0"):
+        return None
+    if stated.get("method", LoopSettings.method) != "pattern":
         reader.add(where, "a survey needs solver.method: pattern")
-    elif budget is not None and survey >= budget:
+        return None
+    if budget is not None and survey >= budget:
         reader.add(where, f"{survey} Sobol points leave nothing of the budget of {budget} "
                           "designs (solver.max_simulations)")
-    else:
-        return survey
-    return None
+        return None
+    return survey
 
 
 def _solver(reader: Reader, value: object) -> dict | None:
@@ -466,9 +475,8 @@ def _solver(reader: Reader, value: object) -> dict | None:
                                         lo_open=lo_open)
                    for key, (dimension, lo, hi, lo_open) in SOLVER_QUANTITIES.items()
                    if key in spec})
-    if stated.get("lattice") and stated["lattice"] & (stated["lattice"] - 1):
-        reader.add(join("solver", "lattice"), f"{stated['lattice']} is not a power of two "
-                                              "(8, 16, 32, ... 1024)")
+    if stated.get("lattice") and not _power_of_two(reader, "lattice", stated["lattice"],
+                                                    "8, 16, 32, ... 1024"):
         stated["lattice"] = None
     if "method" in spec:
         stated["method"] = reader.choice(spec, "method", "solver", LOOP_METHODS)

@@ -361,14 +361,13 @@ def search(space: DesignSpace | Population, cap, settings: LoopSettings,
     return out
 
 
-def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int,
-           hold=lambda value: value.hold) -> list[Trial]:
+def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int) -> list[Trial]:
     """The first ``points`` points of the scrambled Sobol sequence in the
     box (:func:`~design.solvers.optimize.multistart.starting_designs`' seed,
     so a multistart's starts are its first points) that keep the design
     rules, scored together by ``score(designs, incumbent)`` against the
     ``baseline`` (scaled start ``d0``). Of those that ``beat`` it and
-    ``hold`` longer than it by more than :data:`HOLD_BAND` (a design that
+    hold longer than it by more than :data:`HOLD_BAND` (a design that
     keeps limits the baseline breaks by holding nothing is no start), the
     best, the first of equals, is marked taken: the search starts there."""
     designs = [d for d in starting_designs(d0, points + 1, SURVEY_SEED)[1:] if allowed(d)]
@@ -376,7 +375,7 @@ def survey(score, d0: np.ndarray, baseline, beats, allowed, points: int,
               for d, value in zip(designs, score(designs, baseline))]
     best = None
     for t in trials:
-        if beats(t.value, baseline) and hold(t.value) > hold(baseline) + HOLD_BAND and \
+        if beats(t.value, baseline) and t.value.hold > baseline.hold + HOLD_BAND and \
                 (best is None or beats(t.value, best.value)):
             best = t
     if best:
