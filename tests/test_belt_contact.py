@@ -508,7 +508,7 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
     is continued from one belt-only state into the bird three times, the bird
     a few micrometres apart: the first switch into interior+belt needs a
     Newton solve, the later ones none (the chord method with that mode's
-    latest Jacobian inverse), and each contact is a fresh solver's to 1e-12 N."""
+    latest Jacobian factors), and each contact is a fresh solver's to 1e-12 N."""
     finger = Finger(LENGTH, thesis_finger().stiffness)
 
     def resting(solver: SpatialBeltContact) -> Belted:
@@ -537,11 +537,11 @@ def fold_case():
     belt at an accepted instant 1.3475 s into the run, and a trial 0.1 ms
     later past the fold where that contact ends (tests/data/football_fold.npz,
     saved from the run): a fresh solver, the accepted state (with the
-    Jacobian inverse its commit keeps) and the trial's bird, laws and belt."""
+    Jacobian factors its commit keeps) and the trial's bird, laws and belt."""
     d = np.load(Path(__file__).parent / "data" / "football_fold.npz")
     finger = next(gf.finger for gf in football_setup().grasper.fingers if gf.name == "5a")
     belted = SpatialBeltContact(SpatialContact(finger, intervals=3))
-    previous = belted.with_inverse(Belted(
+    previous = belted.with_lu(Belted(
         str(d["mode"]), d["z"], d["bird"], d["pfriction"], Plane.from_params(d["pplane"]),
         d["pbelt"], d["post"], float(d["held"]), int(d["side"]), graze=float(d["graze"])))
     target = (Quadric.from_params(d["quadric"]), law(d["friction"]), Plane.from_params(d["plane"]),

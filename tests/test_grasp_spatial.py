@@ -85,7 +85,7 @@ def test_a_commit_keeps_the_trial_solved_at_its_instant():
             (s.normal_out_of_plane, s.sweep_out_of_plane)
         if s.solution is not None:
             assert np.array_equal(k.solution.shape_points, s.solution.shape_points)
-            assert np.array_equal(k.continued.inverse, s.continued.inverse)
+            assert all(np.array_equal(a, b) for a, b in zip(k.continued.lu, s.continued.lu))
     nxt = [f.evaluate(0.008, y2)[0] for f in (reused, fresh)]
     assert (nxt[0].qx, nxt[0].qz, nxt[0].ty) == (nxt[1].qx, nxt[1].qz, nxt[1].ty)
 

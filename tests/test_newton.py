@@ -61,17 +61,61 @@ def test_residual_tolerance_stops_at_a_small_residual():
     assert res.converged and abs(res.residual[0]) <= 1e-6
 
 
-def test_a_chord_jacobian_that_is_not_finite_has_no_inverse():
-    """A Jacobian with a NaN (here √(z - 2)'s at z = 1) inverts to NaN
-    without an error; the chord method must not iterate with it (its caller
-    falls back to Newton), and a finite one is inverted."""
+def test_a_chord_jacobian_that_is_not_finite_or_singular_has_no_factors():
+    """A Jacobian with a NaN (here √(z - 2)'s at z = 1) factors to NaN
+    without an error, and a singular one has a zero pivot; the chord method
+    must iterate with neither (its caller falls back to Newton). A finite,
+    regular one is factored: its factors solve J x = b."""
     import casadi as ca
 
     from design.solvers.newton import Chord
     z, q = ca.SX.sym("z", 2), ca.SX.sym("q", 1)
     residual = ca.Function("nan_jacobian", [z, q], [
-        ca.vertcat(ca.sqrt(z[0] - 2) + z[1] - q[0], z[1] - q[0])])
+        ca.vertcat(ca.sqrt(z[0] - 2) + z[1] - q[0], (z[0] - 6) * z[1] - q[0])])
     chord = Chord(residual)
-    assert chord.inverse(np.array([1.0, 1.0]), np.array([1.0])) is None
-    np.testing.assert_allclose(chord.inverse(np.array([6.0, 1.0]), np.array([1.0])),
-                               [[4.0, -4.0], [0.0, 1.0]], atol=1e-12)
+    assert chord.factor(np.array([1.0, 1.0]), np.array([1.0])) is None
+    assert chord.factor(np.array([6.0, 0.0]), np.array([1.0])) is None     # second row zero
+    lu = chord.factor(np.array([6.0, 1.0]), np.array([1.0]))
+    # J = [[1/4, 1], [1, 0]] at (6, 1)
+    np.testing.assert_allclose(chord._step(lu, np.array([1.25, 1.0])), [1.0, 1.0], atol=1e-15)
+
+
+def _cubic_chord():
+    """R(z, q) = (z0³ + z0 - q0, z1 - z0 q1): one real root for every q."""
+    import casadi as ca
+
+    from design.solvers.newton import Chord
+    z, q = ca.SX.sym("z", 2), ca.SX.sym("q", 2)
+    return Chord(ca.Function("cubic", [z, q], [ca.vertcat(z[0] ** 3 + z[0] - q[0],
+                                                          z[1] - z[0] * q[1])]))
+
+
+def test_chord_newton_converges_quadratically_and_hands_on_its_factors():
+    """Newton from far (z0 = 10 for the root 1 of z³ + z = 2) reaches the
+    root to 1e-14 in the iterations undamped Newton needs from there (the
+    line search halves no step of this monotone cubic: 10 iterations), and
+    the factors it returns let the chord method reach a nearby root."""
+    chord = _cubic_chord()
+    root = chord.newton(np.array([10.0, 0.0]), np.array([2.0, 3.0]), 1e-14, 30)
+    assert root.converged and root.iterations == 10
+    np.testing.assert_allclose(root.z, [1.0, 3.0], atol=1e-14)
+    # the chord method from there to q0 = 2.01 with the kept factors
+    near = chord.solve(root.z, np.array([2.01, 3.0]), root.lu, 1e-14, 30)
+    assert near is not None and abs(near[0] ** 3 + near[0] - 2.01) <= 1e-14
+    # at the root already: no iteration, no factors
+    again = chord.newton(root.z, np.array([2.0, 3.0]), 1e-12, 30)
+    assert again.converged and again.iterations == 0 and again.lu is None
+
+
+def test_chord_newton_gives_up_at_once_where_no_step_reduces_the_residual():
+    """z0² + 1 = q0 has no root for q0 = 0.5 (the residual's least value is
+    0.5 at z0 = 0): from z0 = 0.1 Newton's steps overshoot past 0 and the
+    line search finds no reduction near the minimum, so the solve ends long
+    before its 30 iterations, not converged, without a NaN."""
+    import casadi as ca
+
+    from design.solvers.newton import Chord
+    z, q = ca.SX.sym("z", 1), ca.SX.sym("q", 1)
+    chord = Chord(ca.Function("no_root", [z, q], [z ** 2 + 1 - q]))
+    root = chord.newton(np.array([0.1]), np.array([0.5]), 1e-12, 30)
+    assert not root.converged and root.iterations < 10 and np.all(np.isfinite(root.z))

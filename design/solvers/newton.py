@@ -2,16 +2,19 @@
 
 :func:`damped_newton` solves numpy systems (the beam's finite differences
 and shooting, the thesis's Algorithm II, the BDF-4 step); :class:`NewtonCache`
-builds CasADi rootfinders once per setting (the contact equations).
+builds CasADi rootfinders once per setting (the contact equations inside the
+design NLP); :class:`Chord` solves a simulation's contact continuation steps
+(Newton, and the chord method on the LU factors Newton leaves).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import casadi as ca
 import numpy as np
+from scipy.linalg import get_lapack_funcs
 
 
 @dataclass(frozen=True)
@@ -153,16 +156,42 @@ def compiled_jacobian(residual: ca.Function, name: str) -> ca.Function:
     return compiled([ca.Function(name, [z, q], [ca.jacobian(r, z), r])]).functions[0]
 
 
+class LU(NamedTuple):
+    """LU factors of a Jacobian with their row pivots (LAPACK's getrf)."""
+
+    lu: np.ndarray
+    piv: np.ndarray
+
+
+class Root(NamedTuple):
+    """:meth:`Chord.newton`'s last iterate, the LU factors of the last
+    Jacobian it factored (near the root when converged: the chord method's
+    to continue from; None when z0 was the root), its iterations and
+    whether max |R| met the tolerance."""
+
+    z: np.ndarray
+    lu: LU | None
+    iterations: int
+    converged: bool
+
+
+#: a Newton step cut by halving at most this many times before the solve
+#: gives up: a residual that no cut of the step reduces has no root nearby
+#: (a step across a fold), and the caller takes a shorter step
+LINE_SEARCH_CUTS = 4
+
+
 class Chord:
-    """Newton's method with the Jacobian of a nearby solution (the chord
-    method), for the many short continuation steps of a simulation: each
-    iteration is one residual evaluation (compiled where a compiler is,
-    design/solvers/compiled.py) and one product with the inverse Jacobian
-    kept from that solution, instead of a Jacobian and its factorisation.
-    It converges linearly, fast while the Jacobian has changed little; the
-    caller falls back to Newton where it does not converge within the
-    iterations allowed. The root it converges to satisfies the same
-    tolerance as Newton's."""
+    """Newton's method and the chord method (Newton with the Jacobian of a
+    nearby solution) on one residual R(z, q), for the many short continuation
+    steps of a simulation. A chord iteration is one residual evaluation
+    (compiled where a compiler is, design/solvers/compiled.py) and one solve
+    with the LU factors kept from that solution, instead of a Jacobian and
+    its factorisation; it converges linearly, fast while the Jacobian has
+    changed little, and the caller falls back to :meth:`newton` where it does
+    not converge within the iterations allowed. Both stop at the same
+    residual tolerance. The Jacobian is CasADi's, interpreted: the
+    thousands of factorisations of a simulation do not repay compiling it."""
 
     def __init__(self, residual: ca.Function):
         from design.solvers.buffers import Buffered
@@ -172,20 +201,24 @@ class Chord:
         q = ca.SX.sym("q", residual.size1_in(1))
         self._jacobian = Buffered(ca.Function(f"{residual.name()}_dense_jz", [z, q],
                                               [ca.densify(ca.jacobian(residual(z, q), z))]))
+        self._getrf, self._getrs = get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))
 
-    def inverse(self, z: np.ndarray, q: np.ndarray) -> np.ndarray | None:
-        """∂R/∂z inverted at (z, q); None where it is singular or not finite
-        (a Jacobian with a NaN, e.g. a square root's at 0, inverts to NaN
-        without an error)."""
-        try:
-            inverse = np.linalg.inv(self._jacobian(z, q)[0])
-        except np.linalg.LinAlgError:
+    def factor(self, z: np.ndarray, q: np.ndarray) -> LU | None:
+        """∂R/∂z at (z, q), LU-factored; None where it is singular or not
+        finite (e.g. a square root's derivative at 0)."""
+        jac = self._jacobian(z, q)[0]
+        if not np.all(np.isfinite(jac)):
             return None
-        return inverse if np.all(np.isfinite(inverse)) else None
+        lu, piv, info = self._getrf(jac, overwrite_a=True)
+        return LU(lu, piv) if info == 0 else None
 
-    def solve(self, z0: np.ndarray, q: np.ndarray, inverse: np.ndarray, tolerance: float,
+    def _step(self, factor: LU, r: np.ndarray) -> np.ndarray:
+        return self._getrs(factor.lu, factor.piv, r)[0]
+
+    def solve(self, z0: np.ndarray, q: np.ndarray, factor: LU, tolerance: float,
               max_iter: int) -> np.ndarray | None:
-        """The root from z0 with max |R| ≤ ``tolerance``, or None."""
+        """The root from z0 by the chord method with ``factor``, with max |R|
+        ≤ ``tolerance``, or None."""
         z = np.array(z0, float)
         with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None below
             for _ in range(max_iter + 1):
@@ -195,5 +228,34 @@ class Chord:
                     return z
                 if not np.isfinite(size):
                     return None
-                z -= inverse @ r
+                z -= self._step(factor, r)
         return None
+
+    def newton(self, z0: np.ndarray, q: np.ndarray, tolerance: float, max_iter: int) -> Root:
+        """Newton's method from z0 to max |R| ≤ ``tolerance`` within
+        ``max_iter`` iterations. A step that no halving (at most
+        :data:`LINE_SEARCH_CUTS`) makes reduce max |R| ends the solve."""
+        z = np.array(z0, float)
+        r = self._residual(z, q)[0].ravel()
+        size, factor = float(np.max(np.abs(r))), None
+        with np.errstate(over="ignore", invalid="ignore"):
+            for it in range(max_iter + 1):
+                if size <= tolerance:
+                    return Root(z, factor, it, True)
+                if it == max_iter or not np.isfinite(size):
+                    return Root(z, factor, it, False)
+                factor = self.factor(z, q)
+                if factor is None:
+                    return Root(z, None, it, False)
+                dz, lam = self._step(factor, r), 1.0
+                for _ in range(LINE_SEARCH_CUTS + 1):
+                    z_try = z - lam * dz
+                    r_try = self._residual(z_try, q)[0].ravel()
+                    size_try = float(np.max(np.abs(r_try)))
+                    if size_try < size:
+                        break
+                    lam *= 0.5
+                else:
+                    return Root(z, factor, it + 1, False)
+                z, r, size = z_try, r_try, size_try
+        raise AssertionError("unreachable")

@@ -13,7 +13,7 @@ halve on failure and double on success (first the geometry under the old
 laws, then the laws, as the bird-only solvers do); where a contact starts
 inside it, along its own path to where the contact starts and on in one
 step from there. Each solve is the chord method with the latest Jacobian
-inverse of its mode, Newton where that does not converge (a mode's first
+factors of its mode, Newton where that does not converge (a mode's first
 solve after a switch no longer pays for a Newton solve and a
 factorisation). After every step the contacts are checked:
 
@@ -44,6 +44,7 @@ import numpy as np
 from design.solvers.buffers import Buffered
 from design.solvers.contact.robust import BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS
 from design.solvers.contact.spatial import CHORD_ITERATIONS
+from design.solvers.newton import LU
 
 #: a contact event is located to within this penetration (m) ...
 EVENT_DEPTH = 1e-8
@@ -191,9 +192,9 @@ class Belted:
     held: float = 1.0
     #: planar: the side the bird bends the finger to (+1: towards +y)
     side: int = 0
-    #: the mode's residual Jacobian inverted at z (for the chord method; None:
-    #: not computed)
-    inverse: np.ndarray | None = None
+    #: the LU factors of the mode's residual Jacobian near z (for the chord
+    #: method; None: not computed)
+    lu: LU | None = None
     #: how far (m) the finger may enter the bird before a contact is tried
     #: (GRAZE_DEPTH after a first touch that would pull, else 0)
     graze: float = 0.0
@@ -217,14 +218,14 @@ class BeltedContact:
     max_steps: int = 400
 
     def __init__(self):
-        #: Newton solves of the last :meth:`continued`; rootfinder calls of
-        #: every call (where the chord method did not converge: the costly ones)
+        #: Newton solves of the last :meth:`continued`; Newton's method's calls
+        #: of every call (where the chord method did not converge: the costly ones)
         self.newton_iterations = self.newton_total = 0
         #: whether the last :meth:`continued` lost the continued equilibrium
         self.lost = False
         self._calls: dict = {}
-        #: mode -> the Jacobian inverse at the latest root Newton found in it
-        self._inverses: dict = {}
+        #: mode -> the Jacobian factors of the latest root found in it
+        self._factors: dict = {}
 
     def continued(self, target: Belted, previous: Belted | None, pace: Pace = COMMIT
                   ) -> tuple[Belted | None, str]:
@@ -261,7 +262,7 @@ class BeltedContact:
     def lowered(self, state: Belted) -> Belted:
         """A solved bird-only state (mode, z, bird, friction, belt) with the
         belt lowered to its tip: the belt then comes in from first touch."""
-        post = self.calls(state.mode)[1](state.z, self.q(state))[0].ravel()
+        post = self.calls(state.mode)[0](state.z, self.q(state))[0].ravel()
         solved = self.solved(state, post)
         plane = state.plane.lowered_to(self.tip(solved))
         return self.solved(replace(solved, plane=plane), post)
@@ -377,50 +378,53 @@ class BeltedContact:
                 return None
             touched = new if kind == "bird" else None
             mode, z = switched.mode, switched.z
-            at = replace(at, side=switched.side, inverse=None)
+            at = replace(at, side=switched.side, lu=None)
         return None
 
     def _newton(self, state: Belted) -> Belted | None:
         """Newton in the state's mode at its parameters from its z; None when
         it does not converge within MAX_STEP_ITERATIONS. The chord method
-        goes first, with the state's Jacobian inverse or else its mode's
+        goes first, with the state's Jacobian factors or else its mode's
         latest in this continuation (a state switched into a mode has none);
-        where Newton takes over, the inverse at its root becomes the mode's
-        latest. The state solved carries the inverse it was solved with."""
+        where Newton takes over, the factors of its last iteration become
+        the mode's latest. The state solved carries the factors it was
+        solved with."""
         if state.mode == "free":
             return state
-        newton, post = self.calls(state.mode)[:2]
+        post = self.calls(state.mode)[0]
         q = self.q(state)
         chord = self.transcription(state.mode).chord
-        inverse = state.inverse if state.inverse is not None else self._inverses.get(state.mode)
-        z = None if inverse is None else chord.solve(state.z, q, inverse, self.tolerance,
-                                                     CHORD_ITERATIONS)
-        if z is None:
-            z, inverse = newton(state.z, q)[0].ravel(), None
+        lu = state.lu if state.lu is not None else self._factors.get(state.mode)
+        z = None if lu is None else chord.solve(state.z, q, lu, self.tolerance, CHORD_ITERATIONS)
+        newton = z is None
+        if newton:
             self.newton_total += 1
+            root = chord.newton(state.z, q, self.tolerance, MAX_STEP_ITERATIONS)
+            if not root.converged:
+                return None
+            z, lu = root.z, root.lu or chord.factor(root.z, q)
         self.newton_iterations += 1
         post, resid = (v.ravel() for v in post(z, q))
         if not (np.isfinite(resid[0]) and resid[0] < 1e-8):
             return None
-        if inverse is None:
-            inverse = self._inverses[state.mode] = chord.inverse(z, q)
-        return self.solved(replace(state, z=z, inverse=inverse), post)
+        if newton:
+            self._factors[state.mode] = lu
+        return self.solved(replace(state, z=z, lu=lu), post)
 
-    def with_inverse(self, state: Belted) -> Belted:
-        """The state with its Jacobian inverse, for continuing by the chord method."""
+    def with_lu(self, state: Belted) -> Belted:
+        """The state with its Jacobian's LU factors, for continuing by the
+        chord method."""
         if state.mode == "free":
             return state
-        return replace(state, inverse=self.transcription(state.mode).chord.inverse(
+        return replace(state, lu=self.transcription(state.mode).chord.factor(
             state.z, self.q(state)))
 
-    def calls(self, mode: str) -> tuple[Buffered, Buffered, Buffered]:
-        """A mode's Newton solve (z0, q) -> z (at most MAX_STEP_ITERATIONS
-        iterations), post values and the finger's shape, called through
+    def calls(self, mode: str) -> tuple[Buffered, Buffered]:
+        """A mode's post values and the finger's shape, called through
         buffers (design/solvers/buffers.py)."""
         if mode not in self._calls:
             tr = self.transcription(mode)
-            self._calls[mode] = (Buffered(tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)),
-                                 Buffered(tr.post), Buffered(tr.shape))
+            self._calls[mode] = (Buffered(tr.post), Buffered(tr.shape))
         return self._calls[mode]
 
     # --------------------------------------------------------- the model's

@@ -77,7 +77,7 @@ class PlanarBeltContact(BeltedContact):
         state, msg = self.continued(target, previous)
         if state is None:
             return self._failed(msg), None
-        return self._solution(state, msg, detail), self.with_inverse(state) if detail else state
+        return self._solution(state, msg, detail), self.with_lu(state) if detail else state
 
     def adopt(self, state, line: Plane, belt: np.ndarray) -> Belted:
         """A bird-only state of :class:`RobustContact` to continue here, with
@@ -127,7 +127,7 @@ class PlanarBeltContact(BeltedContact):
                 k = self._kappa_index(mode)
                 z[k], z[k + 1] = -z[k], z[k + 1] + np.pi
                 state = replace(state, z=z)
-                post = self.calls(mode)[1](z, self.q(state))[0].ravel()
+                post = self.calls(mode)[0](z, self.q(state))[0].ravel()
             if state.side * post[11] <= 0:        # bent the other way: another branch
                 return None
         if mode in BELT_MODES:
@@ -218,7 +218,7 @@ class PlanarBeltContact(BeltedContact):
         """The finger's points (2, n), base to tip."""
         if state.mode == "free":
             return np.vstack([np.linspace(0.0, self.length, 16), np.zeros(16)])
-        shape = self.calls(state.mode)[2](state.z, self.q(state))
+        shape = self.calls(state.mode)[1](state.z, self.q(state))
         if state.mode in BELT_MODES:
             return shape[0]
         x, y = shape[1].ravel(), shape[2].ravel()
@@ -229,7 +229,7 @@ class PlanarBeltContact(BeltedContact):
 
     def _deepest(self, state: Belted) -> Deepest:
         """Where a ``belt`` state's finger goes deepest into the bird."""
-        points, tangents = self.calls(state.mode)[2](state.z, self.q(state))
+        points, tangents = self.calls(state.mode)[1](state.z, self.q(state))
         return deepest(points, tangents, state.bird[:2], _matrix(state.bird))
 
     def _bird_depth(self, state: Belted) -> float:

@@ -37,7 +37,7 @@ from design.solvers.contact.robust import (BASE_FRACTION, BASE_REACHED, MAX_STEP
                                          PENETRATION_TOL, follow)
 from design.solvers.contact.spatial_equations import MODES, spatial_transcription
 from design.solvers.buffers import Buffered, evaluate
-from design.solvers.newton import implicit_rate
+from design.solvers.newton import LU, implicit_rate
 
 #: the straight finger is not inside the object at its deepest point (it
 #: touches it at most): a touch without force, not a failure
@@ -122,9 +122,9 @@ class SpatialState:
     quadric: Quadric
     friction: np.ndarray
     post: np.ndarray
-    #: the residual's Jacobian inverted at z (for the chord method; None: not
-    #: computed, as for a trial evaluation's state)
-    inverse: np.ndarray | None = None
+    #: the LU factors of the residual's Jacobian at z (for the chord method;
+    #: None: not computed, as for a trial evaluation's state)
+    lu: LU | None = None
 
 
 @dataclass(frozen=True)
@@ -266,7 +266,6 @@ class SpatialContact:
         self.post = {m: Buffered(self.tr[m].post) for m in MODES}
         self.shape = {m: Buffered(self.tr[m].shape) for m in MODES}
         self.newton_iterations = 0
-        self._last_iterations = 0
 
     # ----------------------------------------------------------------- API
     def solve(self, quadric: Quadric, friction: FrictionLaw | np.ndarray = FrictionLaw(),
@@ -303,7 +302,7 @@ class SpatialContact:
         """What an accepted instant keeps of a solve without detail: the
         solution with the finger's shape (a finger that passes into the
         object away from the contact is not converged), and the state with
-        its Jacobian inverse, to continue from by the chord method. A solve
+        its Jacobian's LU factors, to continue from by the chord method. A solve
         that ended without a state (no contact: a graze, a finger that left
         the bird) has nothing to add."""
         if state is None:
@@ -322,18 +321,18 @@ class SpatialContact:
             sol = replace(sol, converged=False, penetration=float(depth), message="; ".join(
                 m for m in (sol.message, f"the finger passes {depth:.3g} m into the object "
                                          f"away from the contact") if m))
-        return replace(sol, shape_points=r), replace(state, inverse=tr.chord.inverse(state.z, q))
+        return replace(sol, shape_points=r), replace(state, lu=tr.chord.factor(state.z, q))
 
     def _chord(self, previous: SpatialState, quadric: Quadric, friction: np.ndarray
                ) -> SpatialState | None:
         """The contact at the new parameters by the chord method from
         ``previous`` (its mode kept), if it has its Jacobian and converges
         within CHORD_ITERATIONS with the mode still right; else None."""
-        if previous.inverse is None:
+        if previous.lu is None:
             return None
         tr = self.tr[previous.mode]
         q = self._params(quadric, friction)
-        z = tr.chord.solve(previous.z, q, previous.inverse, self.tolerance, CHORD_ITERATIONS)
+        z = tr.chord.solve(previous.z, q, previous.lu, self.tolerance, CHORD_ITERATIONS)
         if z is None:
             return None
         post = self.post[previous.mode](z, q)[0].ravel()
@@ -448,7 +447,7 @@ class SpatialContact:
         nw = self.tr["interior"].rod.n_w
         for _ in range(3):
             z_new, ok, post = self._newton(mode, z, quadric, friction)
-            if not ok or self._last_iterations > MAX_STEP_ITERATIONS:
+            if not ok:
                 return None
             verdict = self._check(mode, post)
             if verdict == "ok":
@@ -464,15 +463,12 @@ class SpatialContact:
     def _newton(self, mode, z0, quadric, friction):
         tr = self.tr[mode]
         q = self._params(quadric, friction)
-        rf = tr.rootfinder(self.tolerance, MAX_STEP_ITERATIONS)
-        z = np.asarray(rf(z0, q)).ravel()
-        stats = rf.stats()
-        self._last_iterations = int(stats.get("iter_count", 0))
-        self.newton_iterations += self._last_iterations
-        post, resid = (v.ravel() for v in self.post[mode](z, q))
-        ok = bool(stats.get("success", False)) and np.isfinite(resid[0]) \
-            and resid[0] < RESIDUAL_TOL
-        return z, ok, post
+        root = tr.chord.newton(z0, q, self.tolerance, MAX_STEP_ITERATIONS)
+        self.newton_iterations += root.iterations
+        if not root.converged:
+            return root.z, False, None
+        post, resid = (v.ravel() for v in self.post[mode](root.z, q))
+        return root.z, bool(np.isfinite(resid[0]) and resid[0] < RESIDUAL_TOL), post
 
     def _check(self, mode, post) -> str:
         """'ok', 'tip', 'interior', 'release' or 'base' (see the module docstring)."""

@@ -84,11 +84,11 @@ class SpatialBeltContact(BeltedContact):
     def detailed(self, sol: SpatialSolution, state: Belted) -> tuple[SpatialSolution, Belted]:
         """What an accepted instant keeps of a solve without detail: the
         solution with the finger's shape and how far it lies below the belt,
-        and the state with its Jacobian inverse (the chord method's)."""
+        and the state with its Jacobian's LU factors (the chord method's)."""
         pts = self._points(state)
         return (replace(sol, shape_points=pts,
                         below_belt=float(max(0.0, -state.plane.level(pts).min()))),
-                self.with_inverse(state))
+                self.with_lu(state))
 
     def adopt(self, state: SpatialState, plane: Plane, belt) -> Belted:
         """A bird-only state of :class:`SpatialContact` to continue here, with
@@ -199,7 +199,7 @@ class SpatialBeltContact(BeltedContact):
         """The finger's points (3, n), base to tip."""
         if state.mode == "free":
             return np.vstack([np.linspace(0.0, self.length, 16), np.zeros((2, 16))])
-        shape = self.calls(state.mode)[2](state.z, self.q(state))
+        shape = self.calls(state.mode)[1](state.z, self.q(state))
         if state.mode in BELT_MODES:
             return shape[0]
         r = shape[1]
