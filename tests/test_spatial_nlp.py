@@ -219,7 +219,7 @@ def test_the_nlp_finger_on_the_belt_is_the_simulators(finger_5a_on_the_belt):
 
 
 def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget(monkeypatch):
-    """The count of the belt continuations' rootfinder calls is the run's own
+    """The count of the belt continuations' Newton solves is the run's own
     (the same on every machine): a budget below it stops the run, not ok,
     saying where and why, as soon as the count passes it (at the evaluation
     that passes it, an accepted instant's as a trial's); the unlimited run
@@ -229,7 +229,7 @@ def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget(monkeypat
     stopped = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=1e-6),
                              SPATIAL_NODES)
     assert not stopped.summary["ok"]
-    assert re.search(r"Newton rootfinder \d+ times, over the budget of 1e-06 per simulated "
+    assert re.search(r"Newton's method \d+ times, over the budget of 1e-06 per simulated "
                      r"second", stopped.summary["message"])
     assert stopped.trajectory.records[-1].t < run.trajectory.records[-1].t
     # a budget of 2 calls in the run (it makes 4) stops it at the evaluation
@@ -248,7 +248,7 @@ def test_a_run_stops_where_its_belt_contact_costs_more_than_its_budget(monkeypat
     simulate_grasp(setup, LOOP_SIMULATOR, SPATIAL_NODES)          # the whole run's evaluations
     two = simulate_grasp(setup, replace(LOOP_SIMULATOR, max_newton_solves=2 / setup.duration),
                          SPATIAL_NODES)
-    found = re.search(r"stopped at t = ([\d.]+) s: .* rootfinder (\d+) times",
+    found = re.search(r"stopped at t = ([\d.]+) s: .* method (\d+) times",
                       two.summary["message"])
     assert not two.summary["ok"] and int(found.group(2)) == 3
     # the third call is an accepted instant's, and the next trial is elsewhere

@@ -221,14 +221,14 @@ class ContactFailed(RuntimeError):
 
 
 class OverBudget(RuntimeError):
-    """The belt continuations' Newton rootfinder calls passed the run's
+    """The belt continuations' Newton solves passed the run's
     budget (IntegratorSettings.max_newton_solves per simulated second): the
     run stops there, as soon as the count passes it after its first instant
     (which is always kept)."""
 
     def __init__(self, t: float, solves: int, per_second: float):
-        super().__init__(f"stopped at t = {t:.4f} s: the belt continuations called their Newton "
-                         f"rootfinder {solves} times, over the budget of {per_second:g} per "
+        super().__init__(f"stopped at t = {t:.4f} s: the belt continuations called Newton's "
+                         f"method {solves} times, over the budget of {per_second:g} per "
                          f"simulated second")
 
 
@@ -463,7 +463,7 @@ class SpatialFinger:
 
     def detailed(self, sol: SpatialSolution, state) -> tuple[SpatialSolution, object]:
         """A trial's solve with the detail its commit adds (the finger's shape,
-        the continuation's Jacobian inverse): what :meth:`solve` with
+        the continuation's Jacobian factors): what :meth:`solve` with
         ``commit`` returns from the same start at the same instant."""
         solver = self.belted if isinstance(state, Belted) else self.solver
         return solver.detailed(sol, state)
@@ -583,7 +583,7 @@ class FingerForces:
         #: each of them adds nothing to the run (:func:`clear_at`)
         self.probes: list[tuple[float, float, float, float]] = []
         self.reached: set[int] = set()
-        #: (the run's most belt-continuation rootfinder calls, the budget per
+        #: (the run's most belt-continuation Newton solves, the budget per
         #: simulated second) or None: no budget (:class:`OverBudget`)
         self.budget: tuple[float, float] | None = None
         self._memo: dict = {}      # trial evaluations since the last commit
@@ -675,7 +675,7 @@ class FingerForces:
 
     @property
     def newton_solves(self) -> int:
-        """The belt continuations' Newton rootfinder calls so far, every
+        """The belt continuations' Newton solves so far, every
         finger's (the costly part of a run's contact work, where the chord
         method did not converge): the same count on every machine."""
         return sum(0 if m._belted is None else m._belted.newton_total for m in self.models)

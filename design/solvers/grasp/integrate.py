@@ -76,7 +76,7 @@ class IntegratorSettings:
     #: accuracy targets stays under it, the thesis's own steps do not
     #: (``python -m benchmarks.grasp``'s bdf4 rows, docs/performance.md).
     max_local_error: float = 1e-3
-    #: a run whose belt continuations call their Newton rootfinder more than
+    #: a run whose belt continuations call Newton's method more than
     #: this per simulated second (of the whole run) stops, not ok, as soon as
     #: the count passes it (None: no limit). Unlike ``max_wall_time``, the
     #: count is the same on every machine.
