@@ -54,10 +54,13 @@ def main() -> None:
                 (ball, "the default stepper, rk45", replace(own, stepper="rk45")))
 
     def once(case, integrator):
+        """The run's wall time and what the table reports of it; the run
+        itself is dropped, as a user's process would: keeping every run's
+        states (about 80 MB each) slows the later runs' allocations."""
         _, setup, nodes = case
         t0 = time.perf_counter()
         run = simulate_grasp(setup, integrator, nodes)
-        return time.perf_counter() - t0, run
+        return time.perf_counter() - t0, (run.summary, run.trajectory.steps, run.contact_solves)
 
     for case, _, integrator in variants:
         once(case, integrator)                          # warm: builds its functions
@@ -66,15 +69,14 @@ def main() -> None:
     rows = []
     for k, ((name, setup, _), label, integrator) in enumerate(variants):
         walls = [t[k][0] for t in timed]
-        run = timed[-1][k][1]
-        s = run.summary
+        s, steps, solves = timed[-1][k][1]
         wall = statistics.median(walls)
         rows.append({"scene": name, "simulator": label, "stepper": integrator.stepper,
                      "rtol": integrator.rtol, "max_step_s": integrator.max_step, "wall_s": wall,
                      "walls_s": walls, "simulated_s": setup.duration,
                      "wall_per_simulated_s": wall / setup.duration,
                      "hold_time_s": s["hold_time_s"], "max_finger_force_N": s["max_finger_force_N"],
-                     "steps": run.trajectory.steps, "contact_solves": run.contact_solves})
+                     "steps": steps, "contact_solves": solves})
     for r in rows:
         r["over_scene_settings"] = r["wall_s"] / next(
             o["wall_s"] for o in rows if o["scene"] == r["scene"] and "own" in o["simulator"])
