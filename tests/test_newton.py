@@ -77,7 +77,7 @@ def test_a_chord_jacobian_that_is_not_finite_or_singular_has_no_factors():
     assert chord.factor(np.array([6.0, 0.0]), np.array([1.0])) is None     # second row zero
     lu = chord.factor(np.array([6.0, 1.0]), np.array([1.0]))
     # J = [[1/4, 1], [1, 0]] at (6, 1)
-    np.testing.assert_allclose(chord._step(lu, np.array([1.25, 1.0])), [1.0, 1.0], atol=1e-15)
+    np.testing.assert_allclose(chord.lu_solve(lu, np.array([1.25, 1.0])), [1.0, 1.0], atol=1e-15)
 
 
 def _cubic_chord():

@@ -212,7 +212,8 @@ class Chord:
         lu, piv, info = self._getrf(jac, overwrite_a=True)
         return LU(lu, piv) if info == 0 else None
 
-    def _step(self, factor: LU, r: np.ndarray) -> np.ndarray:
+    def lu_solve(self, factor: LU, r: np.ndarray) -> np.ndarray:
+        """J⁻¹ r from the LU factors of J."""
         return self._getrs(factor.lu, factor.piv, r)[0]
 
     def solve(self, z0: np.ndarray, q: np.ndarray, factor: LU, tolerance: float,
@@ -228,7 +229,7 @@ class Chord:
                     return z
                 if not np.isfinite(size):
                     return None
-                z -= self._step(factor, r)
+                z -= self.lu_solve(factor, r)
         return None
 
     def newton(self, z0: np.ndarray, q: np.ndarray, tolerance: float, max_iter: int) -> Root:
@@ -247,7 +248,7 @@ class Chord:
                 factor = self.factor(z, q)
                 if factor is None:
                     return Root(z, None, it, False)
-                dz, lam = self._step(factor, r), 1.0
+                dz, lam = self.lu_solve(factor, r), 1.0
                 for _ in range(LINE_SEARCH_CUTS + 1):
                     z_try = z - lam * dz
                     r_try = self._residual(z_try, q)[0].ravel()
