@@ -23,6 +23,7 @@ from functools import lru_cache
 
 import casadi as ca
 import numpy as np
+import scipy
 import threadpoolctl
 
 #: MUMPS's fill-reducing ordering for Ipopt: approximate minimum fill (2),
@@ -72,11 +73,14 @@ def _ipopt_line() -> str:
 
 
 def numerics() -> dict:
-    """The numerical libraries and settings of this process, for result.json."""
+    """The numerical libraries and settings of this process, for result.json:
+    ``numpy_blas`` lists every BLAS loaded, numpy's and scipy's (the
+    simulations' contact solves factor their Jacobians with scipy's LAPACK)."""
     blas = [{"library": os.path.basename(i["filepath"]), "api": i.get("internal_api"),
              "version": i.get("version"), "kernels": i.get("architecture"),
              "threads": i.get("num_threads")} for i in threadpoolctl.threadpool_info()
             if i.get("user_api") == "blas"]
     return {"casadi": ca.__version__, "ipopt": ipopt_build(),
-            "ipopt_ordering": IPOPT_ORDERING, "numpy": np.__version__, "numpy_blas": blas,
+            "ipopt_ordering": IPOPT_ORDERING, "numpy": np.__version__,
+            "scipy": scipy.__version__, "numpy_blas": blas,
             "environment": {v: os.environ.get(v) for v in BLAS_VARIABLES}}
