@@ -102,6 +102,9 @@ def test_chord_newton_converges_quadratically_and_hands_on_its_factors():
     # the chord method from there to q0 = 2.01 with the kept factors
     near = chord.solve(root.z, np.array([2.01, 3.0]), root.lu, 1e-14, 30)
     assert near is not None and abs(near[0] ** 3 + near[0] - 2.01) <= 1e-14
+    # three iterations are not enough from there: not converged, the third iterate
+    short = chord.newton(np.array([10.0, 0.0]), np.array([2.0, 3.0]), 1e-14, 3)
+    assert not short.converged and short.iterations == 3 and short.z[0] > 1.5
     # at the root already: no iteration, no factors
     again = chord.newton(root.z, np.array([2.0, 3.0]), 1e-12, 30)
     assert again.converged and again.iterations == 0 and again.lu is None

@@ -240,10 +240,10 @@ class Chord:
         r = self._residual(z, q)[0].ravel()
         size, factor = float(np.max(np.abs(r))), None
         with np.errstate(over="ignore", invalid="ignore"):
-            for it in range(max_iter + 1):
+            for it in range(max_iter):
                 if size <= tolerance:
                     return Root(z, factor, it, True)
-                if it == max_iter or not np.isfinite(size):
+                if not np.isfinite(size):
                     return Root(z, factor, it, False)
                 factor = self.factor(z, q)
                 if factor is None:
@@ -259,4 +259,4 @@ class Chord:
                 else:
                     return Root(z, factor, it + 1, False)
                 z, r, size = z_try, r_try, size_try
-        raise AssertionError("unreachable")
+        return Root(z, factor, max_iter, size <= tolerance)

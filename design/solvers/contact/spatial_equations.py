@@ -139,8 +139,8 @@ class SpatialContactTranscription:
         """Newton on R(z, q) = 0: (z0, q) -> z (cached; design.solvers.newton).
         ``compiled_jacobian``: its Jacobian compiled, faster per evaluation
         after seconds of gcc per mode once (an empty cache): for the
-        optimiser's hundreds of thousands of solves, not for a simulation's
-        thousands (``python -m benchmarks.solve`` profiles both)."""
+        optimiser's hundreds of thousands of solves (a simulation's
+        continuation steps use :attr:`chord` instead)."""
         return self._newton.get(tolerance, max_iter, error_on_fail, compiled_jacobian)
 
 
