@@ -508,7 +508,9 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
     is continued from one belt-only state into the bird three times, the bird
     a few micrometres apart: the first switch into interior+belt needs a
     Newton solve, the later ones none (the chord method with that mode's
-    latest Jacobian factors), and each contact is a fresh solver's to 1e-12 N."""
+    latest Jacobian factors), and each contact is a fresh solver's to 1e-11 N
+    (both stop at residuals of 1e-12, which leaves the roots found from
+    different factors about 1e-12 N apart; another equilibrium lies far off)."""
     finger = Finger(LENGTH, thesis_finger().stiffness)
 
     def resting(solver: SpatialBeltContact) -> Belted:
@@ -527,8 +529,8 @@ def test_a_switch_into_a_mode_reuses_its_latest_jacobian():
         fresh = SpatialBeltContact(SpatialContact(finger, intervals=8))
         alone, _ = fresh.solve(pressing_bird(height), FrictionLaw(), PRESSED_BELT,
                                spatial_law(0.0), resting(fresh))
-        assert sol.normal_force == pytest.approx(alone.normal_force, abs=1e-12)
-        assert sol.belt_normal_force == pytest.approx(alone.belt_normal_force, abs=1e-12)
+        assert sol.normal_force == pytest.approx(alone.normal_force, abs=1e-11)
+        assert sol.belt_normal_force == pytest.approx(alone.belt_normal_force, abs=1e-11)
 
 
 def fold_case():

@@ -3,11 +3,13 @@
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 from design.io.scene import load_scene
 from design.reproduce.grasp import MEAN_START, mean_bird_setup
 from design.run.grasp import setup_of
 from design.solvers.contact.belt_continuation import BIRD_MODES, Belted
+from design.solvers.contact.spatial import segment_level
 from design.solvers.grasp.fingers import RATE_STEP, FingerForces, body_quadric
 
 
@@ -110,7 +112,8 @@ def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():
     difference quotient over RATE_STEP of the point carried with the bird
     and seen from the drum-turned frame (1e-8 m/s: rounding of positions of
     0.1 m divided by the 1e-6 s step). The mean bird moving and pitching
-    at finger 4a."""
+    at finger 4a. Its quadric and the straight finger's level, computed
+    with every finger's at once, are the single finger's (to rounding)."""
     setup = mean_bird_setup("soft")
     forces = fingers_of(setup)
     b = setup.bird
@@ -119,7 +122,12 @@ def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():
     body = forces.ellipsoid(y)
     i = [gf.name for gf in setup.grasper.fingers].index("4a")
     base, R = forces.frame(i, t)
-    motion = forces._kinematics(i, t, y, body_quadric(body, base, R))
+    view = forces._views(t, y, body)[i]
+    quadric = body_quadric(body, base, R)
+    np.testing.assert_allclose(view.quadric.params, quadric.params, rtol=1e-13, atol=1e-15)
+    length = setup.grasper.fingers[i].finger.length
+    assert view.level == pytest.approx(segment_level(quadric, length), rel=1e-12, abs=1e-14)
+    motion = view.motion
     y2 = y.copy()
     y2[:3] += dt * y[3:]
     later = forces.ellipsoid(y2)

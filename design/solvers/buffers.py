@@ -36,6 +36,21 @@ class Buffered:
         for i, out in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(out))
 
+    @property
+    def inputs(self) -> list[np.ndarray]:
+        """The buffer's inputs (flat, column-major): fill them, then :meth:`run`."""
+        return self._inputs
+
+    def run(self) -> list[np.ndarray]:
+        """Evaluate on :attr:`inputs` as they stand; the outputs (flat,
+        column-major) are views of the buffer, overwritten by the next call:
+        the fast path for a loop that reuses most inputs and consumes each
+        output at once."""
+        self._run()
+        if self._buffer.ret() != 0:
+            raise RuntimeError(f"{self.name} failed (return code {self._buffer.ret()})")
+        return self._outputs
+
     def __call__(self, *args) -> list[np.ndarray]:
         for i, (buf, a) in enumerate(zip(self._inputs, args)):
             a = np.asarray(a, dtype=float).ravel(order="F")

@@ -221,15 +221,18 @@ class Chord:
         """The root from z0 by the chord method with ``factor``, with max |R|
         ≤ ``tolerance``, or None."""
         z = np.array(z0, float)
+        z_in, q_in = self._residual.inputs
+        q_in[:] = q
         with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None below
             for _ in range(max_iter + 1):
-                r = self._residual(z, q)[0].ravel()
-                size = np.max(np.abs(r))
+                z_in[:] = z
+                r = self._residual.run()[0]
+                size = np.abs(r).max()
                 if size <= tolerance:
                     return z
                 if not np.isfinite(size):
                     return None
-                z -= self.lu_solve(factor, r)
+                z -= self._getrs(factor.lu, factor.piv, r)[0]
         return None
 
     def newton(self, z0: np.ndarray, q: np.ndarray, tolerance: float, max_iter: int) -> Root:

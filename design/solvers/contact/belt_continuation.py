@@ -384,18 +384,24 @@ class BeltedContact:
     def _newton(self, state: Belted) -> Belted | None:
         """Newton in the state's mode at its parameters from its z; None when
         it does not converge within MAX_STEP_ITERATIONS. The chord method
-        goes first, with the state's Jacobian factors or else its mode's
-        latest in this continuation (a state switched into a mode has none);
-        where Newton takes over, the factors of its last iteration become
-        the mode's latest. The state solved carries the factors it was
-        solved with."""
+        goes first, with its mode's latest Jacobian factors (the latest
+        Newton's or :meth:`with_lu`'s: nearest the states an integrator's
+        trials solve again and again about one instant), then with the
+        state's own; where Newton takes over, the factors of its last
+        iteration become the mode's latest. The state solved carries the
+        factors it was solved with."""
         if state.mode == "free":
             return state
         post = self.calls(state.mode)[0]
         q = self.q(state)
         chord = self.transcription(state.mode).chord
-        lu = state.lu if state.lu is not None else self._factors.get(state.mode)
-        z = None if lu is None else chord.solve(state.z, q, lu, self.tolerance, CHORD_ITERATIONS)
+        z, lu = None, None
+        latest = self._factors.get(state.mode)
+        for lu in (latest, None if state.lu is latest else state.lu):
+            if lu is not None:
+                z = chord.solve(state.z, q, lu, self.tolerance, CHORD_ITERATIONS)
+                if z is not None:
+                    break
         newton = z is None
         if newton:
             self.newton_total += 1
@@ -416,8 +422,10 @@ class BeltedContact:
         chord method."""
         if state.mode == "free":
             return state
-        return replace(state, lu=self.transcription(state.mode).chord.factor(
-            state.z, self.q(state)))
+        lu = self.transcription(state.mode).chord.factor(state.z, self.q(state))
+        if lu is not None:
+            self._factors[state.mode] = lu
+        return replace(state, lu=lu)
 
     def calls(self, mode: str) -> tuple[Buffered, Buffered]:
         """A mode's post values and the finger's shape, called through

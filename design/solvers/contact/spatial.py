@@ -266,21 +266,24 @@ class SpatialContact:
         self.post = {m: Buffered(self.tr[m].post) for m in MODES}
         self.shape = {m: Buffered(self.tr[m].shape) for m in MODES}
         self.newton_iterations = 0
+        #: mode -> the Jacobian factors of the latest root found in it
+        self._factors: dict[str, LU] = {}
 
     # ----------------------------------------------------------------- API
     def solve(self, quadric: Quadric, friction: FrictionLaw | np.ndarray = FrictionLaw(),
-              previous: SpatialState | None = None, detail: bool = True
-              ) -> tuple[SpatialSolution, SpatialState | None]:
+              previous: SpatialState | None = None, detail: bool = True,
+              level: float | None = None) -> tuple[SpatialSolution, SpatialState | None]:
         """Contact of the finger with ``quadric`` (finger frame) under a
         friction law or a given friction vector (3,), continued from
-        ``previous``. Returns the solution and the state to continue from."""
+        ``previous``; ``level``: the straight finger's :func:`segment_level`,
+        if known. Returns the solution and the state to continue from."""
         self.newton_iterations = 0
         length = self.finger.length
         friction = FrictionLaw.of(friction).params
         if quadric.level(np.zeros((3, 1)))[0] <= 0.0:
             return no_spatial_contact(length, "the finger base is inside the object: invalid "
                                               "pose", converged=False), None
-        if segment_level(quadric, length) >= 0.0:
+        if (segment_level(quadric, length) if level is None else level) >= 0.0:
             return no_spatial_contact(length, "the straight finger misses the object"), None
         # the usual case, a short step: geometry and friction in one solve, by
         # the chord method from the continued solution's Jacobian, else Newton
@@ -321,18 +324,30 @@ class SpatialContact:
             sol = replace(sol, converged=False, penetration=float(depth), message="; ".join(
                 m for m in (sol.message, f"the finger passes {depth:.3g} m into the object "
                                          f"away from the contact") if m))
-        return replace(sol, shape_points=r), replace(state, lu=tr.chord.factor(state.z, q))
+        lu = tr.chord.factor(state.z, q)
+        if lu is not None:
+            self._factors[state.mode] = lu
+        return replace(sol, shape_points=r), replace(state, lu=lu)
 
     def _chord(self, previous: SpatialState, quadric: Quadric, friction: np.ndarray
                ) -> SpatialState | None:
         """The contact at the new parameters by the chord method from
-        ``previous`` (its mode kept), if it has its Jacobian and converges
-        within CHORD_ITERATIONS with the mode still right; else None."""
+        ``previous`` (its mode kept), if it has its Jacobian factors and
+        converges within CHORD_ITERATIONS with the mode still right; else
+        None. It tries the mode's latest factors first (the latest Newton's
+        or commit's: nearest the states an integrator's trials solve again
+        and again about one instant), then ``previous``'s own."""
         if previous.lu is None:
             return None
         tr = self.tr[previous.mode]
         q = self._params(quadric, friction)
-        z = tr.chord.solve(previous.z, q, previous.lu, self.tolerance, CHORD_ITERATIONS)
+        z = None
+        latest = self._factors.get(previous.mode)
+        for lu in (latest, None if previous.lu is latest else previous.lu):
+            if lu is not None:
+                z = tr.chord.solve(previous.z, q, lu, self.tolerance, CHORD_ITERATIONS)
+                if z is not None:
+                    break
         if z is None:
             return None
         post = self.post[previous.mode](z, q)[0].ravel()
@@ -468,7 +483,10 @@ class SpatialContact:
         if not root.converged:
             return root.z, False, None
         post, resid = (v.ravel() for v in self.post[mode](root.z, q))
-        return root.z, bool(np.isfinite(resid[0]) and resid[0] < RESIDUAL_TOL), post
+        ok = bool(np.isfinite(resid[0]) and resid[0] < RESIDUAL_TOL)
+        if ok and root.lu is not None:
+            self._factors[mode] = root.lu
+        return root.z, ok, post
 
     def _check(self, mode, post) -> str:
         """'ok', 'tip', 'interior', 'release' or 'base' (see the module docstring)."""

@@ -46,6 +46,7 @@ again and again, each try solving the first touch afresh.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from typing import NamedTuple
 from functools import cached_property
 
 import numpy as np
@@ -240,6 +241,7 @@ class PlanarFinger:
 
     name = "planar"
     from_committed = False
+    in_frames = False
     #: a trial may start a contact (continued from the latest trial's)
     touches_at_commits = False
     #: the friction's sense follows the finger's sliding (settled at accepted steps)
@@ -388,6 +390,8 @@ class SpatialFinger:
 
     name = "spatial"
     from_committed = True
+    #: solves with the bird in its frame computed with the other fingers' (FrameViews)
+    in_frames = True
     #: friction solved with the contact, regularised: nothing to reverse
     reverses = False
     #: no trial starts a contact: an integrator step ends where one starts
@@ -406,27 +410,29 @@ class SpatialFinger:
             self._belted = SpatialBeltContact(self.solver)
         return self._belted
 
-    def solve(self, body: Ellipsoid, base, R, kin_factory, start, commit: bool, belt=None):
-        """As :meth:`PlanarFinger.solve`; ``belt``: (plane, friction law) in the
-        finger frame where the finger may meet the belt, else None."""
-        quadric = body_quadric(body, base, R)
-        misses = segment_level(quadric, self.solver.finger.length) >= 0.0
+    def solve(self, view: "FrameView", base, R, start, commit: bool, belt=None):
+        """As :meth:`PlanarFinger.solve`, with the bird as the finger's frame
+        sees it (``view``, computed with the other fingers': :class:`FrameViews`)
+        instead of the bird and its kinematics; ``belt``: (plane, friction
+        law) in the finger frame where the finger may meet the belt, else
+        None."""
+        quadric = view.quadric
         resting = self._resting(belt)
         if isinstance(start, Belted) and not (resting or start.mode in BELT_MODES):
             start = self.belted.bird_only(start)         # off the belt: the bird-only solver
         if belt is not None and (resting or isinstance(start, Belted)):
-            return self._belted_solve(body, quadric, base, R, kin_factory,
+            return self._belted_solve(quadric, self._law(view.motion), base, R,
                                       start if isinstance(start, Belted) else None, commit, belt)
-        if misses:
+        if view.level >= 0.0:
             return None, None, None, None
         start = start if isinstance(start, SpatialState) else None
-        sol, cont = self.solver.solve(quadric, self._law(kin_factory, quadric), start,
-                                      detail=commit)
+        law = self._law(view.motion)
+        sol, cont = self.solver.solve(quadric, law, start, detail=commit, level=view.level)
         if belt is not None and sol.contact and cont is not None and \
                 belt[0].level(self._tip(sol, cont)[:, None])[0] < 0.0:
             # pushed into the belt by the bird: solved with it from the bird-only state
-            return self._belted_solve(body, quadric, base, R, kin_factory,
-                                      self.belted.adopt(cont, *belt), commit, belt)
+            return self._belted_solve(quadric, law, base, R, self.belted.adopt(cont, *belt),
+                                      commit, belt)
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
@@ -468,12 +474,12 @@ class SpatialFinger:
         solver = self.belted if isinstance(state, Belted) else self.solver
         return solver.detailed(sol, state)
 
-    def _law(self, kin_factory, quadric) -> FrictionLaw:
+    def _law(self, motion: "SurfaceMotion") -> FrictionLaw:
         """The bird's friction law in the finger frame: regularised Coulomb
-        against the rigid finger's sliding over the bird's surface."""
+        against the rigid finger's sliding over the bird's surface (its
+        ``motion`` relative to the frame)."""
         if self.mu <= 0:
             return FrictionLaw()
-        motion = kin_factory(quadric)
         return FrictionLaw(mu=self.mu, speed=FRICTION_SPEED, sliding_at_origin=-motion.v0,
                            sliding_gradient=-motion.gradient)
 
@@ -482,11 +488,11 @@ class SpatialFinger:
         post = state.post
         return post[:3] + post[13:16] * (self.solver.finger.length - post[4])
 
-    def _belted_solve(self, body, quadric, base, R, kin_factory, start, commit, belt):
+    def _belted_solve(self, quadric, law, base, R, start, commit, belt):
         """The finger with the belt and the bird (its continuation finds where
         the bent finger first meets the bird)."""
-        sol, cont = self.belted.solve(quadric, self._law(kin_factory, quadric), belt[0], belt[1],
-                                      start, detail=commit, trial=not commit)
+        sol, cont = self.belted.solve(quadric, law, belt[0], belt[1], start, detail=commit,
+                                      trial=not commit)
         if not sol.contact:
             return np.zeros(3), None, sol, cont
         return R @ sol.force, base + R @ sol.point, sol, cont
@@ -550,6 +556,64 @@ def body_quadric(body: Ellipsoid, base: np.ndarray, R: np.ndarray) -> Quadric:
     return Quadric(R.T @ (np.asarray(body.center, float) - base), Rb @ body.matrix @ Rb.T)
 
 
+class FrameView(NamedTuple):
+    """The bird in one finger's frame at one instant (spatial fingers): its
+    quadric, the straight finger's level in it (:func:`segment_level`) and
+    its surface's motion relative to the frame."""
+
+    quadric: Quadric
+    level: float
+    motion: SurfaceMotion
+
+
+class FrameViews:
+    """Every finger's :class:`FrameView` at one instant, computed together:
+    ``frames`` (bases (n, 3), rotations (n, 3, 3)) at time t with the bird
+    ``body``, ``frames_later`` and the bird ``later`` dt on (the surface's
+    motion is their forward difference: a point p of the finger frame is
+    carried with the bird to t + dt and seen in the finger's frame then,
+    affine in p); ``lengths`` (n,) m. Index with a finger's number."""
+
+    def __init__(self, body: Ellipsoid, later: Ellipsoid, dt: float, frames, frames_later,
+                 lengths: np.ndarray):
+        bases, R = frames
+        bases2, R2 = frames_later
+        rot, rot2 = body.rotation, later.rotation
+        centre, centre2 = np.asarray(body.center, float), np.asarray(later.center, float)
+        Rt, R2t = R.transpose(0, 2, 1), R2.transpose(0, 2, 1)
+        self.centres = np.einsum("nij,nj->ni", Rt, centre - bases)
+        Rb = Rt @ rot
+        self.matrices = (Rb * np.diag(body.matrix)) @ Rb.transpose(0, 2, 1)
+        # the straight finger's deepest point x* = c·Q e_x / Q00, clipped to it
+        Q0 = self.matrices[:, 0]
+        x = np.clip(np.einsum("nj,nj->n", Q0, self.centres) / Q0[:, 0], 0.0, lengths)
+        d = -self.centres
+        d[:, 0] += x
+        self.levels = np.einsum("ni,nij,nj->n", d, self.matrices, d) - 1.0
+        turn = R2t @ (rot2 @ rot.T)
+        self.v0 = (np.einsum("nij,nj->ni", R2t, centre2 - bases2) +
+                   np.einsum("nij,nj->ni", turn, bases - centre)) / dt
+        self.gradients = (turn @ R - np.eye(3)) / dt
+        self._later = (later, R2t, bases2, dt)
+        self._views: dict[int, FrameView] = {}
+
+    def __getitem__(self, k: int) -> FrameView:
+        view = self._views.get(k)
+        if view is None:
+            quadric = Quadric(self.centres[k], self.matrices[k])
+            view = self._views[k] = FrameView(quadric, float(self.levels[k]), SurfaceMotion(
+                self.v0[k], self.gradients[k], lambda: self._rates(k, quadric)))
+        return view
+
+    def _rates(self, k: int, quadric: Quadric) -> np.ndarray:
+        """The rates of finger k's quadric parameters (forward difference)."""
+        later, R2t, bases2, dt = self._later
+        Rb = R2t[k] @ later.rotation
+        moved = Quadric(R2t[k] @ (np.asarray(later.center, float) - bases2[k]),
+                        Rb @ later.matrix @ Rb.T)
+        return (moved.params - quadric.params) / dt
+
+
 class FingerForces:
     """All fingers' forces on the bird, continued in time finger by finger.
 
@@ -593,6 +657,9 @@ class FingerForces:
         self._committed = False    # an instant accepted
         self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
         self._frames: dict = {}    # t -> every finger's frame, for the latest times
+        self._belts: dict = {}     # (finger, t, belt speed) -> the belt it sees, likewise
+        self._frame_views: dict = {}   # (t, y) -> FrameViews, for the latest instants
+        self._inside: dict = {}    # t -> the fingers to look at, likewise
         start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
         self._base0 = np.array([base for base, _ in start])
         self._R0 = np.array([R for _, R in start])
@@ -633,30 +700,56 @@ class FingerForces:
         evaluation solves the same ones, so that a trial sees what the
         accepted instant will."""
         self.probes.append((t, body.center[0], body.center[2], body.pitch))
-        if self._window_ends is None:
-            inside = np.arange(len(self.models))
-        else:
-            lo, hi, owner = self._window_ends
-            inside = np.unique(owner[(lo <= t) & (t <= hi)])
+        inside, resting = self._candidates(t)
         self.skipped += len(self.models) - inside.size
         if inside.size == 0:
             return set()
         bases, rotations = self.frames(t)
-        axes, lengths = rotations[inside, :, 0], self._lengths[inside]
-        out = set(inside[straight_level(body, bases[inside], axes, lengths) <= MISSES].tolist())
-        tips = bases[inside] + axes * lengths[:, None]
-        below = tips[:, 2] < 0
-        resting = [i for i, tip in zip(inside[below], tips[below])
-                   if self.belt.touches(self.grasper.fingers[i].design_name, tip[1])]
-        out |= set(int(i) for i in resting)
+        levels = straight_level(body, bases[inside], rotations[inside, :, 0], self._lengths[inside])
+        out = set(inside[levels <= MISSES].tolist()) | resting
         self.reached |= out
+        return out
+
+    def _candidates(self, t: float) -> tuple[np.ndarray, set[int]]:
+        """The fingers inside their reach windows at time t, and those of them
+        resting on the belt (the straight tip below it, where the finger
+        meets it), kept for the latest times, as :meth:`frames` is."""
+        out = self._inside.get(t)
+        if out is None:
+            if len(self._inside) > 64:
+                self._inside.clear()
+            if self._window_ends is None:
+                inside = np.arange(len(self.models))
+            else:
+                lo, hi, owner = self._window_ends
+                inside = np.unique(owner[(lo <= t) & (t <= hi)])
+            resting = set()
+            if inside.size:
+                bases, rotations = self.frames(t)
+                tips = bases[inside] + rotations[inside, :, 0] * self._lengths[inside][:, None]
+                below = tips[:, 2] < 0
+                resting = {int(i) for i, tip in zip(inside[below], tips[below])
+                           if self.belt.touches(self.grasper.fingers[i].design_name, tip[1])}
+            out = self._inside[t] = inside, resting
         return out
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the
         friction law against the finger's sliding over the moving belt, in
         the finger frame; None where the finger passes beside it or through
-        a slot (judged at its straight tip)."""
+        a slot (judged at its straight tip). Kept for the latest times, as
+        :meth:`frames` is."""
+        key = (i, t, self.belt_speed(t))
+        if key not in self._belts:
+            if len(self._belts) > 256:
+                self._belts.clear()
+            out = self._belts[key] = self._belt_contact(i, t, key[2])
+            for a in () if out is None else (out[0].normal, *vars(out[1]).values()):
+                if isinstance(a, np.ndarray):
+                    a.setflags(write=False)
+        return self._belts[key]
+
+    def _belt_contact(self, i: int, t: float, speed: float) -> tuple[Plane, FrictionLaw] | None:
         base, R = self.frame(i, t)
         tip = base + R[:, 0] * self._lengths[i]
         if not self.belt.touches(self.grasper.fingers[i].design_name, tip[1]):
@@ -666,7 +759,7 @@ class FingerForces:
             return plane, FrictionLaw()
         dt = RATE_STEP
         base2, R2 = self.frame(i, t + dt)
-        belt = np.array([self.belt_speed(t) * dt, 0.0, 0.0])
+        belt = np.array([speed * dt, 0.0, 0.0])
         # the belt's material velocity relative to the finger frame at r: v0 + G r
         v0 = R2.T @ (base + belt - base2) / dt
         G = (R2.T @ R - np.eye(3)) / dt
@@ -702,6 +795,7 @@ class FingerForces:
             self.touched = [i for i in waiting if self.models[i].touching(self.states[i])]
             self._committed = True
             self._memo.clear()
+            self._margins.clear()
             self._margins.clear()
         elif len(self._memo) > 16:
             self._memo.pop(next(iter(self._memo)))
@@ -754,8 +848,25 @@ class FingerForces:
         # committed one, so that trials cannot wander onto another branch
         model = self.models[i]
         start = self.states[i] if commit or model.from_committed else self.trials[i]
+        belt = self.belt_contact(i, t)
+        if model.in_frames:
+            return model.solve(self._views(t, y, body)[i], base, R, start, commit, belt)
         return model.solve(body, base, R, lambda shape: self._kinematics(i, t, y, shape), start,
-                           commit, self.belt_contact(i, t))
+                           commit, belt)
+
+    def _views(self, t: float, y: np.ndarray, body: Ellipsoid) -> FrameViews:
+        """The bird in every finger's frame at (t, y), kept for the latest instants."""
+        key = (t, y.tobytes())
+        views = self._frame_views.get(key)
+        if views is None:
+            if len(self._frame_views) > 16:
+                self._frame_views.clear()
+            later = y.copy()
+            later[:3] += RATE_STEP * y[3:]
+            views = self._frame_views[key] = FrameViews(
+                body, self.ellipsoid(later), RATE_STEP, self.frames(t),
+                self.frames(t + RATE_STEP), self._lengths)
+        return views
 
     def _state(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, solved, commit: bool,
                loads: Loads) -> FingerState:
@@ -887,26 +998,17 @@ class FingerForces:
         speed = np.linalg.norm(v)
         return float(abs(n @ R[:, 2])), float(abs(v @ R[:, 2]) / speed) if speed > 0 else 0.0
 
-    def _kinematics(self, i: int, t: float, y: np.ndarray, shape):
-        """Rates of the bird's section (planar: the cut ellipse) or quadric
-        (spatial) in finger i's frame, and the bird's surface velocity
-        relative to that frame, by a forward difference over RATE_STEP
-        (spatial: as a :class:`SurfaceMotion`)."""
+    def _kinematics(self, i: int, t: float, y: np.ndarray, cut: Ellipse):
+        """Rates of the bird's section ``cut`` (a planar finger's ellipse) in
+        finger i's frame, and the bird's surface velocity relative to that
+        frame, by a forward difference over RATE_STEP (spatial fingers:
+        :class:`FrameViews`)."""
         dt = RATE_STEP
         y2 = y.copy()
         y2[:3] += dt * y[3:]
         base, R = self.frame(i, t)
         base2, R2 = self.frame(i, t + dt)
         body, body2 = self.ellipsoid(y), self.ellipsoid(y2)
-        if not isinstance(shape, Ellipse):
-            # p_f -> the point's world position at t, carried with the bird to
-            # t + dt, back in the finger frame then: affine in p_f
-            turn = R2.T @ body2.rotation @ body.rotation.T
-            v0 = (R2.T @ (np.asarray(body2.center) - base2) +
-                  turn @ (base - np.asarray(body.center))) / dt
-            rates = lambda: (body_quadric(body2, base2, R2).params - shape.params) / dt  # noqa: E731
-            return SurfaceMotion(v0, (turn @ R - np.eye(3)) / dt, rates)
-        cut = shape
 
         def surface_velocity(p_f: np.ndarray) -> np.ndarray:
             p3 = np.concatenate([p_f, [0.0]])

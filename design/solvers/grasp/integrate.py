@@ -141,9 +141,18 @@ class Grasp:
         self.dyn, self.conveyor, self.fingers = dynamics, conveyor, fingers
         self.start: float | None = conveyor.start_time if conveyor.decelerates else None
         fingers.belt_speed = lambda t: self.belt(t)[0]
+        self._belt: dict = {}      # (t, start) -> the belt's motion, for the latest times
 
     def belt(self, t: float) -> tuple[float, float]:
-        return self.conveyor.velocity(t, self.start)
+        """The belt's speed (m/s) and acceleration (m/s²) at t: an integrator
+        step asks at its few stage times again and again."""
+        key = (t, self.start)
+        out = self._belt.get(key)
+        if out is None:
+            if len(self._belt) > 64:
+                self._belt.clear()
+            out = self._belt[key] = self.conveyor.velocity(t, self.start)
+        return out
 
     def solve_mode(self, t, y, mode, slip_sign, loads):
         v, v_dot = self.belt(t)
