@@ -559,11 +559,11 @@ def law(p: np.ndarray) -> FrictionLaw:
 
 def test_a_trial_past_a_fold_finds_at_its_coarser_stall_what_the_accepted_instant_finds():
     """Past the fold the continued equilibrium ends: a trial, at the TRIAL
-    pace (steps cut to 1/16, stalled at 1e-3 of the path), and the accepted
-    instant, at the COMMIT pace (halved, stalled at 1e-7), both lose it and
-    find the same state afresh (the finger off the ball, on the belt: 1e-9
-    N), the trial for under a third of the Newton solves (each cut of the
-    step near a fold costs two failed ones)."""
+    pace (its step whole, lost where Newton cannot take it), and the
+    accepted instant, at the COMMIT pace (halved, stalled at 1e-7), both
+    lose it and find the same state afresh (the finger off the ball, on the
+    belt: 1e-9 N), the trial for under a tenth of the Newton solves (the
+    commit creeps up to the fold: 51 against 4)."""
     found = []
     for trial in (True, False):
         belted, previous, target = fold_case()
@@ -573,7 +573,7 @@ def test_a_trial_past_a_fold_finds_at_its_coarser_stall_what_the_accepted_instan
     (trial, t_state, t_cost), (commit, c_state, c_cost) = found
     assert t_state.mode == c_state.mode == "belt"
     assert trial.belt_normal_force == pytest.approx(commit.belt_normal_force, abs=1e-9)
-    assert t_cost < c_cost / 3
+    assert t_cost < c_cost / 10
 
 
 def test_a_trial_short_of_the_fold_follows_the_continued_equilibrium():

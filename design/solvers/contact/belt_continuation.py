@@ -68,11 +68,15 @@ class Pace(NamedTuple):
 
 #: the accepted instant's pace: halving, a fold located to 1e-7 of the path
 COMMIT = Pace(1e-7, 2.0)
-#: an integrator's trial, continued from the accepted state: it only has to
-#: tell that its step crosses a fold (its instant, if accepted, is solved
-#: again at COMMIT's pace), and each cut of a step costs two failed Newton
-#: solves near a fold: cut to 1/16, given up at 1e-3
-TRIAL = Pace(1e-3, 16.0)
+#: an integrator's trial, continued from the accepted state, takes its step
+#: whole: where Newton cannot take it, its equilibrium counts as lost (found
+#: afresh). It only has to tell that its step crosses a fold: its instant, if
+#: accepted, is solved again at COMMIT's pace, and a step too long for Newton
+#: is the integrator's to shorten, which it does when the force found afresh
+#: makes it reject the step. (Cutting the step to 1/16, down to 1e-3 of it,
+#: cost each trial past a fold about ten failed Newton solves, and an
+#: integrator retries a step across a fold many times.)
+TRIAL = Pace(1.0, 2.0)
 #: the finger's modes that touch the bird, and those that touch the belt
 BIRD_MODES = ("interior", "tip", "tip+belt", "interior+belt")
 BELT_MODES = ("belt", "tip+belt", "interior+belt")
