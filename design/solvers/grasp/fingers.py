@@ -614,6 +614,16 @@ class FrameViews:
         return (moved.params - quadric.params) / dt
 
 
+def _nearer(accepted, trial):
+    """The state to continue a finger's contact from for :meth:`FingerForces.
+    varied`: its trial's, where that is of the accepted state's kind (with
+    the accepted state's Jacobian factors, where it has none), else the
+    accepted state."""
+    if trial is None or type(trial) is not type(accepted):
+        return accepted
+    return trial if trial.lu is not None else replace(trial, lu=accepted.lu)
+
+
 class FingerForces:
     """All fingers' forces on the bird, continued in time finger by finger.
 
@@ -927,6 +937,25 @@ class FingerForces:
                 sol, cont = self.models[i].detailed(st.solution, st.continued)
                 states.append(self._kept(i, t, y, body, st.force, st.point, sol, cont, True))
         return loads, states
+
+    def varied(self, t: float, y: np.ndarray, near: tuple[float, np.ndarray]) -> Loads:
+        """The loads at (t, y), a trial evaluation whose contacts continue
+        from their trial at the instant ``near`` (t, y) a hair away (an
+        integrator's difference quotient) instead of from the accepted state:
+        the same contacts, found from much nearer. Leaves this object as it
+        was."""
+        key = (near[0], near[1].tobytes())
+        if key not in self._memo:
+            self.evaluate(*near)
+        (_, trials), _ = self._memo[key]
+        starts = [_nearer(state, trial.continued) for state, trial in zip(self.states, trials)]
+        kept = self.states, self.trials, self._memo, self._margins
+        self.states, self.trials = starts, list(self.trials)
+        self._memo, self._margins = {}, {}
+        try:
+            return self._evaluate(t, y, commit=False)[0][0]
+        finally:
+            self.states, self.trials, self._memo, self._margins = kept
 
     def probe(self, t: float, y: np.ndarray, snapshot: tuple[list, list]) -> list[FingerState]:
         """The fingers' states at (t, y), a trial evaluation continued from an

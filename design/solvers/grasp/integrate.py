@@ -46,6 +46,10 @@ from design.solvers.grasp.peaks import PeakFinder, Span
 from design.solvers.newton import damped_newton, forward_difference
 
 STEPPERS = {"dop853": DOP853, "rk45": RK45, "radau": Radau}
+#: the steppers that take the right-hand side's Jacobian (Grasp.jacobian)
+IMPLICIT = ("radau",)
+#: relative step of Grasp.jacobian's differences: sqrt of the double's epsilon
+JACOBIAN_STEP = np.finfo(float).eps ** 0.5
 INTEGRATORS = ("adaptive", "bdf4")
 
 
@@ -163,6 +167,22 @@ class Grasp:
         loads, _ = self.fingers.evaluate(t, y)
         acc, _, _ = self.solve_mode(t, y, mode, slip_sign, loads)
         return np.concatenate([y[3:], acc])
+
+    def jacobian(self, t, y, mode, slip_sign, threshold):
+        """∂rhs/∂y by forward differences, column j stepped by sqrt(eps)
+        max(|y_j|, ``threshold``) (scipy's first choice), each varied state's
+        contacts continued from those at (t, y): a solve from a hair away
+        instead of from the accepted state."""
+        f = self.rhs(t, y, mode, slip_sign)
+        out = np.empty((y.size, y.size))
+        for j in range(y.size):
+            h = JACOBIAN_STEP * max(abs(y[j]), threshold)
+            varied = y.copy()
+            varied[j] += h
+            acc, _, _ = self.solve_mode(t, varied, mode, slip_sign,
+                                        self.fingers.varied(t, varied, (t, y)))
+            out[:, j] = (np.concatenate([varied[3:], acc]) - f) / (varied[j] - y[j])
+        return out
 
     def record(self, t, y, mode, slip_sign, commit=True) -> Record:
         loads, states = self.fingers.evaluate(t, y, commit=commit)
@@ -390,8 +410,10 @@ def _adaptive(grasp: Grasp, traj: Trajectory, y0, t_end, s: IntegratorSettings, 
     last_report = 0.0
     while t < t_end - 1e-12:
         fun = (lambda m, sg: (lambda tt, yy: grasp.rhs(tt, yy, m, sg)))(mode, slip_sign)
+        jac = {"jac": (lambda m, sg: (lambda tt, yy: grasp.jacobian(tt, yy, m, sg, s.atol)))(
+            mode, slip_sign)} if s.stepper in IMPLICIT else {}
         stepper = STEPPERS[s.stepper](fun, t, y, t_end, rtol=s.rtol, atol=s.atol,
-                                      max_step=s.max_step)
+                                      max_step=s.max_step, **jac)
         events = _events(grasp, mode, slip_sign)
         restart = False
         while not restart and stepper.status == "running":
