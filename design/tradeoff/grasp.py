@@ -30,6 +30,8 @@ CASES = {
     "adaptive rk45, max step 20 ms": IntegratorSettings(max_step=2e-2),
     "adaptive rk45, rtol 1e-6": IntegratorSettings(rtol=1e-6, atol=1e-8),
     "adaptive dop853": IntegratorSettings(stepper="dop853"),
+    # implicit, for scenes whose fingers' regularised friction is stiff
+    "adaptive radau": IntegratorSettings(stepper="radau"),
     # the thesis's method as it ran: no bound on a step's estimated local error
     "bdf4 (thesis) 16.6 ms": IntegratorSettings(integrator="bdf4", step=16.6e-3,
                                                 max_local_error=math.inf),

@@ -648,6 +648,7 @@ class FingerForces:
         self.models = [kind(gf.finger, friction, intervals, degree) for gf in grasper.fingers]
         #: a commit may reuse the trial at its instant (:meth:`_commit_trial`)
         self._trials_from_committed = kind.from_committed
+        self._in_frames = kind.in_frames
         self.states: list = [None] * len(grasper.fingers)    # at the last accepted step
         self.trials: list = [None] * len(grasper.fingers)    # at the latest evaluation
         self.solves = 0            # contact problems solved
@@ -702,11 +703,12 @@ class FingerForces:
         bases, rotations = self.frames(t)
         return bases[i], rotations[i]
 
-    def reaching(self, t: float, body: Ellipsoid) -> set[int]:
-        """The fingers to solve at time t, among those inside their reach
+    def reaching(self, t: float, y: np.ndarray, body: Ellipsoid) -> set[int]:
+        """The fingers to solve at (t, y), among those inside their reach
         windows (the others count as skipped): those whose straight line
-        enters the bird (level ≤ MISSES), and those resting on the belt (the
-        straight tip below it), which the bird may meet bent: every
+        enters the bird (level ≤ MISSES; spatial fingers: the level in
+        their views, :class:`FrameViews`), and those resting on the belt
+        (the straight tip below it), which the bird may meet bent: every
         evaluation solves the same ones, so that a trial sees what the
         accepted instant will."""
         self.probes.append((t, body.center[0], body.center[2], body.pitch))
@@ -714,8 +716,12 @@ class FingerForces:
         self.skipped += len(self.models) - inside.size
         if inside.size == 0:
             return set()
-        bases, rotations = self.frames(t)
-        levels = straight_level(body, bases[inside], rotations[inside, :, 0], self._lengths[inside])
+        if self._in_frames:
+            levels = self._views(t, y, body).levels[inside]
+        else:
+            bases, rotations = self.frames(t)
+            levels = straight_level(body, bases[inside], rotations[inside, :, 0],
+                                    self._lengths[inside])
         out = set(inside[levels <= MISSES].tolist()) | resting
         self.reached |= out
         return out
@@ -831,7 +837,7 @@ class FingerForces:
         waiting = self._waiting()
         margins = [self.models[i].clearance(body, *self.frame(i, t), self.states[i],
                                             self.belt_contact(i, t))
-                   for i in sorted(self.reaching(t, body) & waiting)]
+                   for i in sorted(self.reaching(t, y, body) & waiting)]
         return min([np.inf] + [m for m in margins if m is not None])
 
     def _evaluate(self, t: float, y: np.ndarray, commit: bool
@@ -841,7 +847,7 @@ class FingerForces:
         instant."""
         body = self.ellipsoid(y)
         loads, states = Loads(), []
-        reaching = self.reaching(t, body)
+        reaching = self.reaching(t, y, body)
         waiting = set() if commit else self._waiting()
         skipped = sorted(reaching & waiting)
         for i in range(len(self.models)):
@@ -859,7 +865,7 @@ class FingerForces:
         model = self.models[i]
         start = self.states[i] if commit or model.from_committed else self.trials[i]
         belt = self.belt_contact(i, t)
-        if model.in_frames:
+        if self._in_frames:
             return model.solve(self._views(t, y, body)[i], base, R, start, commit, belt)
         return model.solve(body, base, R, lambda shape: self._kinematics(i, t, y, shape), start,
                            commit, belt)
