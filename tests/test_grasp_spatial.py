@@ -1,5 +1,6 @@
 """The spatial finger model inside a grasp run (docs/MODEL.md, "spatial")."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -10,8 +11,8 @@ from design.reproduce.grasp import MEAN_START, mean_bird_setup
 from design.run.grasp import setup_of
 from design.solvers.buffers import Buffered
 from design.solvers.contact.belt_continuation import BIRD_MODES, Belted
-from design.solvers.contact.spatial import segment_level
-from design.solvers.grasp.fingers import RATE_STEP, FingerForces, body_quadric
+from design.solvers.contact.spatial import SpatialState, segment_level
+from design.solvers.grasp.fingers import RATE_STEP, FingerForces, _nearer, body_quadric
 
 
 def fingers_of(setup) -> FingerForces:
@@ -96,6 +97,20 @@ def test_a_trial_at_the_instant_of_an_earlier_one_continues_from_it(monkeypatch)
     loads = np.array([fresh.qx, fresh.qz, fresh.ty])
     np.testing.assert_allclose([again.qx, again.qz, again.ty], loads,
                                atol=1e-9 * np.abs(loads).max())
+
+
+def test_a_trial_in_another_mode_is_no_start_without_its_own_factors():
+    """A trial that switched the contact into another mode (tip, fewer
+    unknowns) and kept no Jacobian factors cannot take the accepted state's
+    (of the interior mode's size): the accepted state is the start; a trial
+    in the accepted state's mode takes its factors."""
+    (forces,), (y1, _) = main_job_fingers(1)
+    accepted = next(s for s in forces.states if isinstance(s, SpatialState) and s.lu is not None)
+    other = "tip" if accepted.mode == "interior" else "interior"
+    switched = replace(accepted, mode=other, z=accepted.z[:-1], lu=None)
+    assert _nearer(accepted, switched) is accepted
+    same = _nearer(accepted, replace(accepted, lu=None))
+    assert same.lu is accepted.lu and same is not accepted
 
 
 def main_job_fingers(copies: int) -> tuple[list[FingerForces], tuple[np.ndarray, np.ndarray]]:

@@ -615,13 +615,16 @@ class FrameViews:
 
 
 def _nearer(accepted, trial):
-    """The state to continue a finger's contact from for :meth:`FingerForces.
-    varied`: its trial's, where that is of the accepted state's kind (with
-    the accepted state's Jacobian factors, where it has none), else the
-    accepted state."""
+    """The state to continue a spatial finger's contact from instead of the
+    accepted one (:meth:`FingerForces.varied`, a trial at the time of an
+    earlier one): the trial's, where that is of the accepted state's kind
+    and has Jacobian factors of its own or is in the accepted state's mode
+    (it then takes the accepted state's factors), else the accepted state."""
     if trial is None or type(trial) is not type(accepted):
         return accepted
-    return trial if trial.lu is not None else replace(trial, lu=accepted.lu)
+    if trial.lu is not None:
+        return trial
+    return replace(trial, lu=accepted.lu) if trial.mode == accepted.mode else accepted
 
 
 class FingerForces:
@@ -963,13 +966,15 @@ class FingerForces:
         """The loads at (t, y), a trial evaluation whose contacts continue
         from their trial at the instant ``near`` (t, y) a hair away (an
         integrator's difference quotient) instead of from the accepted state:
-        the same contacts, found from much nearer. Leaves this object as it
-        was."""
+        the same contacts, found from much nearer (planar fingers continue
+        from their latest trial, as all their trials do). Leaves this object
+        as it was."""
         key = (near[0], near[1].tobytes())
         if key not in self._memo:
             self.evaluate(*near)
         (_, trials), _ = self._memo[key]
-        starts = [_nearer(state, trial.continued) for state, trial in zip(self.states, trials)]
+        starts = [_nearer(state, trial.continued) for state, trial in zip(self.states, trials)] \
+            if self._trials_from_committed else self.states
         kept = self.states, self.trials, self._memo, self._margins
         self.states, self.trials = starts, list(self.trials)
         self._memo, self._margins = {}, {}
