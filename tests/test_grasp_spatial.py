@@ -77,28 +77,6 @@ def test_a_varied_state_finds_the_contacts_the_accepted_state_finds(monkeypatch)
         assert forces.states == states
 
 
-def test_a_trial_at_the_instant_of_an_earlier_one_continues_from_it(monkeypatch):
-    """An integrator's next iteration at a stage time: a trial at the time of
-    an earlier trial, the bird 1 um and 1 mm/s elsewhere, continues its
-    contacts from that trial: the loads a trial from the accepted state
-    finds (1e-9 relative: the Newton tolerance), in fewer chord iterations.
-    The main job's scene 4 ms after an accepted instant."""
-    (forces, other), (y1, _) = main_job_fingers(2)
-    t = 0.004
-    forces.evaluate(t, y1)
-    y2 = y1 + np.array([1e-6, -1e-6, 1e-6, 1e-3, -1e-3, 1e-3])
-    runs = [0]
-    run = Buffered.run
-    monkeypatch.setattr(Buffered, "run", lambda self: runs.__setitem__(0, runs[0] + 1) or run(self))
-    again, _ = forces.evaluate(t, y2)
-    cost = runs[0]
-    fresh, _ = other.evaluate(t, y2)
-    assert cost < runs[0] - cost
-    loads = np.array([fresh.qx, fresh.qz, fresh.ty])
-    np.testing.assert_allclose([again.qx, again.qz, again.ty], loads,
-                               atol=1e-9 * np.abs(loads).max())
-
-
 def test_a_trial_in_another_mode_is_no_start_without_its_own_factors():
     """A trial that switched the contact into another mode (tip, fewer
     unknowns) and kept no Jacobian factors cannot take the accepted state's

@@ -616,10 +616,10 @@ class FrameViews:
 
 def _nearer(accepted, trial):
     """The state to continue a spatial finger's contact from instead of the
-    accepted one (:meth:`FingerForces.varied`, a trial at the time of an
-    earlier one): the trial's, where that is of the accepted state's kind
-    and has Jacobian factors of its own or is in the accepted state's mode
-    (it then takes the accepted state's factors), else the accepted state."""
+    accepted one for :meth:`FingerForces.varied`: the trial's, where that is
+    of the accepted state's kind and has Jacobian factors of its own or is
+    in the accepted state's mode (it then takes the accepted state's
+    factors), else the accepted state."""
     if trial is None or type(trial) is not type(accepted):
         return accepted
     if trial.lu is not None:
@@ -853,35 +853,20 @@ class FingerForces:
         reaching = self.reaching(t, y, body)
         waiting = set() if commit else self._waiting()
         skipped = sorted(reaching & waiting)
-        instant = None if commit else self._same_instant(t)
         for i in range(len(self.models)):
-            solved = self._solve(i, t, y, body, commit, instant and instant[i]) \
-                if i in reaching - waiting else None
+            solved = self._solve(i, t, y, body, commit) if i in reaching - waiting else None
             states.append(self._state(i, t, y, body, solved, commit, loads))
         return (loads, states), skipped
 
-    def _same_instant(self, t: float) -> list[FingerState] | None:
-        """The states of the latest trial evaluation at time t since the last
-        commit (an integrator's iterations come back to their stage times)."""
-        for (time_, _), ((_, states), _) in reversed(self._memo.items()):
-            if time_ == t:
-                return states
-        return None
-
-    def _solve(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, commit: bool,
-               near: FingerState | None = None):
-        """Finger i's model solved at (t, y): (force, point, solution, state);
-        ``near``: its state in a trial at the same time."""
+    def _solve(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, commit: bool):
+        """Finger i's model solved at (t, y): (force, point, solution, state)."""
         base, R = self.frame(i, t)
         # continue from the latest solution, trial or committed: the nearest
         # in time (trials keep the committed friction); or, for a model whose
-        # friction is solved with the contact (spatial), from the committed
-        # one or a trial at the same time continued from it (not one that
-        # lost it), so that trials cannot wander onto another branch
+        # friction is solved with the contact (spatial), always from the
+        # committed one, so that trials cannot wander onto another branch
         model = self.models[i]
         start = self.states[i] if commit or model.from_committed else self.trials[i]
-        if near is not None and model.from_committed and not near.lost:
-            start = _nearer(start, near.continued)
         belt = self.belt_contact(i, t)
         if self._in_frames:
             return model.solve(self._views(t, y, body)[i], base, R, start, commit, belt)
