@@ -69,13 +69,14 @@ BACK_OFF = 0.9
 #: each loop simulation's budget of the belt continuations' Newton solves
 #: (where the chord method did not converge) per simulated second
 #: (IntegratorSettings.max_newton_solves): Table 5-5's birds at the baseline
-#: make 1.9-4.4 a second, the main job's designs at most 38 in a 1.6 s run, the
-#: multistart's runs that end ok at most 72 (45 a second); a finger pressed
-#: to where its quasi-static contact ends (a fold it snaps through at every
-#: trial of a step, a touch with no consistent contact) makes them by the
-#: hundred within tenths of a second (the multistart's runs stopped by the
-#: budget passed its 480 between 1.07 and 1.24 s), and such a simulation,
-#: unstopped, ran for 10 s to minutes where 2 s is usual. A run stopped by
+#: make 1.9-3.8 a second, the main job's designs at most 14 in a 1.6 s run; a
+#: finger pressed to where its quasi-static contact ends (a fold it snaps
+#: through at every trial of a step, a touch with no consistent contact)
+#: makes them by the hundred within tenths of a second (measured while a
+#: trial still cut its step near a fold, 13 Newton solves where it now makes
+#: 4: the multistart's runs that ended ok made at most 72, those stopped by
+#: the budget passed its 480 between 1.07 and 1.24 s), and such a
+#: simulation, unstopped, ran for 10 s to minutes where 2 s is usual. A run stopped by
 #: it is a failed run, the worst a design can be; the count is the same on
 #: every machine, unlike a wall-time limit.
 LOOP_NEWTON_SOLVES = 300
