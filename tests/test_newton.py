@@ -110,6 +110,24 @@ def test_chord_newton_converges_quadratically_and_hands_on_its_factors():
     assert again.converged and again.iterations == 0 and again.lu is None
 
 
+def test_the_chord_method_takes_the_first_factors_that_converge():
+    """Factors taken in turn: those of a far point (z0 = 10's Jacobian, 75
+    times the root's slope) do not reach the root to 1e-14 within 12 chord
+    iterations; the root's own and those of a point beside it both do, and
+    the first of them listed is taken (None skipped); where none converges,
+    no root and no factors."""
+    chord = _cubic_chord()
+    q = np.array([2.01, 3.0])
+    root = np.array([1.0, 3.0])
+    far = chord.factor(np.array([10.0, 30.0]), q)
+    beside, own = chord.factor(root + 0.01, q), chord.factor(root, q)
+    assert chord.solve(root, q, far, 1e-14, 12) is None
+    for first, second in ((beside, own), (own, beside)):
+        z, used = chord.solve_first(root, q, (None, far, first, second), 1e-14, 12)
+        assert used is first and abs(z[0] ** 3 + z[0] - 2.01) <= 1e-14
+    assert chord.solve_first(root, q, (far, None, far), 1e-14, 12) == (None, None)
+
+
 def test_chord_newton_gives_up_at_once_where_no_step_reduces_the_residual():
     """z0² + 1 = q0 has no root for q0 = 0.5 (the residual's least value is
     0.5 at z0 = 0): from z0 = 0.1 Newton's steps overshoot past 0 and the

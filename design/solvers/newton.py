@@ -235,6 +235,21 @@ class Chord:
                 z -= self._getrs(factor.lu, factor.piv, r)[0]
         return None
 
+    def solve_first(self, z0: np.ndarray, q: np.ndarray, factors: tuple[LU | None, ...],
+                    tolerance: float, max_iter: int) -> tuple[np.ndarray | None, LU | None]:
+        """:meth:`solve` with each of ``factors`` in turn (None and repeats
+        skipped) until one converges: (the root, the factors it took), else
+        (None, None)."""
+        tried: list[LU] = []
+        for factor in factors:
+            if factor is None or any(factor is t for t in tried):
+                continue
+            tried.append(factor)
+            z = self.solve(z0, q, factor, tolerance, max_iter)
+            if z is not None:
+                return z, factor
+        return None, None
+
     def newton(self, z0: np.ndarray, q: np.ndarray, tolerance: float, max_iter: int) -> Root:
         """Newton's method from z0 to max |R| ≤ ``tolerance`` within
         ``max_iter`` iterations. A step that no halving (at most

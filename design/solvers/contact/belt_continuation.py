@@ -399,13 +399,8 @@ class BeltedContact:
         post = self.calls(state.mode)[0]
         q = self.q(state)
         chord = self.transcription(state.mode).chord
-        z, lu = None, None
-        latest = self._factors.get(state.mode)
-        for lu in (latest, None if state.lu is latest else state.lu):
-            if lu is not None:
-                z = chord.solve(state.z, q, lu, self.tolerance, CHORD_ITERATIONS)
-                if z is not None:
-                    break
+        z, lu = chord.solve_first(state.z, q, (self._factors.get(state.mode), state.lu),
+                                  self.tolerance, CHORD_ITERATIONS)
         newton = z is None
         if newton:
             self.newton_total += 1

@@ -341,13 +341,8 @@ class SpatialContact:
             return None
         tr = self.tr[previous.mode]
         q = self._params(quadric, friction)
-        z = None
-        latest = self._factors.get(previous.mode)
-        for lu in (latest, None if previous.lu is latest else previous.lu):
-            if lu is not None:
-                z = tr.chord.solve(previous.z, q, lu, self.tolerance, CHORD_ITERATIONS)
-                if z is not None:
-                    break
+        z, _ = tr.chord.solve_first(previous.z, q, (self._factors.get(previous.mode), previous.lu),
+                                    self.tolerance, CHORD_ITERATIONS)
         if z is None:
             return None
         post = self.post[previous.mode](z, q)[0].ravel()
