@@ -46,8 +46,8 @@ again and again, each try solving the first touch afresh.
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from typing import NamedTuple
 from functools import cached_property
+from typing import NamedTuple
 
 import numpy as np
 
@@ -131,6 +131,24 @@ class FingerState:
 #: every finger out of reach, at every evaluation: one state, read-only
 OUT_OF_REACH = FingerState()
 OUT_OF_REACH.force.setflags(write=False)
+
+
+class Latest(dict):
+    """Values kept for the latest keys (times, instants) an integrator asks
+    about again and again: emptied when it holds more than ``size``."""
+
+    def __init__(self, size: int):
+        super().__init__()
+        self.size = size
+
+    def kept(self, key, make):
+        """The value at ``key``, made by ``make()`` where there is none yet."""
+        if key in self:
+            return self[key]
+        if len(self) > self.size:
+            self.clear()
+        value = self[key] = make()
+        return value
 
 
 def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end: float,
@@ -670,10 +688,10 @@ class FingerForces:
         self.touched: list[int] = []
         self._committed = False    # an instant accepted
         self._margins: dict = {}   # (t, y) -> reversal margin, for the latest evaluations
-        self._frames: dict = {}    # t -> every finger's frame, for the latest times
-        self._belts: dict = {}     # (finger, t, belt speed) -> the belt it sees, likewise
-        self._frame_views: dict = {}   # (t, y) -> FrameViews, for the latest instants
-        self._inside: dict = {}    # t -> the fingers to look at, likewise
+        self._frames = Latest(64)    # t -> every finger's frame
+        self._belts = Latest(256)    # (finger, t, belt speed) -> the belt it sees
+        self._frame_views = Latest(16)    # (t, y) -> FrameViews
+        self._inside = Latest(64)    # t -> the fingers to look at
         start = [self.drum.frame(gf.mount, 0.0) for gf in grasper.fingers]
         self._base0 = np.array([base for base, _ in start])
         self._R0 = np.array([R for _, R in start])
@@ -689,17 +707,14 @@ class FingerForces:
         frames at t = 0 turned with the drum. An evaluation asks for the same
         time several times (reach, contact, rates at t + RATE_STEP, shares);
         the arrays are shared, hence read-only."""
-        out = self._frames.get(t)
-        if out is None:
-            if len(self._frames) > 64:
-                self._frames.clear()
+        def make():
             turn = self.drum.turning(t)
             origin = self.drum.origin
             out = (origin + (self._base0 - origin) @ turn.T, turn @ self._R0)
             for a in out:
                 a.setflags(write=False)
-            self._frames[t] = out
-        return out
+            return out
+        return self._frames.kept(t, make)
 
     def frame(self, i: int, t: float) -> tuple[np.ndarray, np.ndarray]:
         """Finger i's (base, R) at time t (:meth:`frames`)."""
@@ -733,10 +748,7 @@ class FingerForces:
         """The fingers inside their reach windows at time t, and those of them
         resting on the belt (the straight tip below it, where the finger
         meets it), kept for the latest times, as :meth:`frames` is."""
-        out = self._inside.get(t)
-        if out is None:
-            if len(self._inside) > 64:
-                self._inside.clear()
+        def make():
             if self._window_ends is None:
                 inside = np.arange(len(self.models))
             else:
@@ -749,8 +761,8 @@ class FingerForces:
                 below = tips[:, 2] < 0
                 resting = {int(i) for i, tip in zip(inside[below], tips[below])
                            if self.belt.touches(self.grasper.fingers[i].design_name, tip[1])}
-            out = self._inside[t] = inside, resting
-        return out
+            return inside, resting
+        return self._inside.kept(t, make)
 
     def belt_contact(self, i: int, t: float) -> tuple[Plane, FrictionLaw] | None:
         """The belt as finger i sees it at time t: the plane Z = 0 and the
@@ -758,15 +770,15 @@ class FingerForces:
         the finger frame; None where the finger passes beside it or through
         a slot (judged at its straight tip). Kept for the latest times, as
         :meth:`frames` is."""
-        key = (i, t, self.belt_speed(t))
-        if key not in self._belts:
-            if len(self._belts) > 256:
-                self._belts.clear()
-            out = self._belts[key] = self._belt_contact(i, t, key[2])
+        speed = self.belt_speed(t)
+
+        def make():
+            out = self._belt_contact(i, t, speed)
             for a in () if out is None else (out[0].normal, *vars(out[1]).values()):
                 if isinstance(a, np.ndarray):
                     a.setflags(write=False)
-        return self._belts[key]
+            return out
+        return self._belts.kept((i, t, speed), make)
 
     def _belt_contact(self, i: int, t: float, speed: float) -> tuple[Plane, FrictionLaw] | None:
         base, R = self.frame(i, t)
@@ -814,7 +826,6 @@ class FingerForces:
             self.touched = [i for i in waiting if self.models[i].touching(self.states[i])]
             self._committed = True
             self._memo.clear()
-            self._margins.clear()
             self._margins.clear()
         elif len(self._memo) > 16:
             self._memo.pop(next(iter(self._memo)))
@@ -875,17 +886,12 @@ class FingerForces:
 
     def _views(self, t: float, y: np.ndarray, body: Ellipsoid) -> FrameViews:
         """The bird in every finger's frame at (t, y), kept for the latest instants."""
-        key = (t, y.tobytes())
-        views = self._frame_views.get(key)
-        if views is None:
-            if len(self._frame_views) > 16:
-                self._frame_views.clear()
+        def make():
             later = y.copy()
             later[:3] += RATE_STEP * y[3:]
-            views = self._frame_views[key] = FrameViews(
-                body, self.ellipsoid(later), RATE_STEP, self.frames(t),
-                self.frames(t + RATE_STEP), self._lengths)
-        return views
+            return FrameViews(body, self.ellipsoid(later), RATE_STEP, self.frames(t),
+                              self.frames(t + RATE_STEP), self._lengths)
+        return self._frame_views.kept((t, y.tobytes()), make)
 
     def _state(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, solved, commit: bool,
                loads: Loads) -> FingerState:

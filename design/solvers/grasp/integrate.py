@@ -41,7 +41,8 @@ from scipy.integrate import DOP853, RK45, Radau
 from scipy.optimize import brentq
 
 from design.physics.bird import G, BirdDynamics, Conveyor, Loads
-from design.solvers.grasp.fingers import ContactFailed, FingerForces, FingerState, OverBudget
+from design.solvers.grasp.fingers import (ContactFailed, FingerForces, FingerState, Latest,
+                                          OverBudget)
 from design.solvers.grasp.peaks import PeakFinder, Span
 from design.solvers.newton import damped_newton, forward_difference
 
@@ -145,18 +146,12 @@ class Grasp:
         self.dyn, self.conveyor, self.fingers = dynamics, conveyor, fingers
         self.start: float | None = conveyor.start_time if conveyor.decelerates else None
         fingers.belt_speed = lambda t: self.belt(t)[0]
-        self._belt: dict = {}      # (t, start) -> the belt's motion, for the latest times
+        self._belt = Latest(64)    # (t, start) -> the belt's motion
 
     def belt(self, t: float) -> tuple[float, float]:
         """The belt's speed (m/s) and acceleration (m/s²) at t: an integrator
         step asks at its few stage times again and again."""
-        key = (t, self.start)
-        out = self._belt.get(key)
-        if out is None:
-            if len(self._belt) > 64:
-                self._belt.clear()
-            out = self._belt[key] = self.conveyor.velocity(t, self.start)
-        return out
+        return self._belt.kept((t, self.start), lambda: self.conveyor.velocity(t, self.start))
 
     def solve_mode(self, t, y, mode, slip_sign, loads):
         v, v_dot = self.belt(t)
