@@ -90,15 +90,31 @@ def _cubic_chord():
                                                           z[1] - z[0] * q[1])]))
 
 
-def test_chord_newton_converges_quadratically_and_hands_on_its_factors():
-    """Newton from far (z0 = 10 for the root 1 of z³ + z = 2) reaches the
-    root to 1e-14 in the iterations undamped Newton needs from there (the
-    line search halves no step of this monotone cubic: 10 iterations), and
-    the factors it returns let the chord method reach a nearby root."""
+def _counting_factors(chord):
+    """``chord`` with its factorisations counted (the list's length)."""
+    calls, factor = [], chord.factor
+    chord.factor = lambda z, q: calls.append(z[0]) or factor(z, q)
+    return calls
+
+
+def test_chord_newton_keeps_its_factors_while_they_converge_fast(monkeypatch):
+    """Newton from far (z0 = 10 for the root 1 of z³ + z = 2): undamped
+    Newton (no factors kept) takes 10 iterations and 10 Jacobians from there
+    (the line search halves no step of this monotone cubic). Keeping the
+    factors while a step cuts max |R| tenfold, it factors 8 Jacobians: the
+    approach from 10 converges too slowly to keep any, and once at 1 + 4e-5
+    the factors there take it to 1e-14 in 4 iterations, 2 more than
+    Newton's. The factors it returns let the chord method reach a nearby
+    root."""
+    import design.solvers.newton as newton_module
     chord = _cubic_chord()
-    root = chord.newton(np.array([10.0, 0.0]), np.array([2.0, 3.0]), 1e-14, 30)
-    assert root.converged and root.iterations == 10
-    np.testing.assert_allclose(root.z, [1.0, 3.0], atol=1e-14)
+    for keep_below, iterations, jacobians in ((0.0, 10, 10), (0.1, 12, 8)):
+        monkeypatch.setattr(newton_module, "KEEP_FACTORS_BELOW", keep_below)
+        calls = _counting_factors(chord)
+        root = chord.newton(np.array([10.0, 0.0]), np.array([2.0, 3.0]), 1e-14, 30)
+        assert root.converged and (root.iterations, len(calls)) == (iterations, jacobians)
+        np.testing.assert_allclose(root.z, [1.0, 3.0], atol=1e-14)
+        del chord.factor
     # the chord method from there to q0 = 2.01 with the kept factors
     near = chord.solve(root.z, np.array([2.01, 3.0]), root.lu, 1e-14, 30)
     assert near is not None and abs(near[0] ** 3 + near[0] - 2.01) <= 1e-14
@@ -140,3 +156,82 @@ def test_chord_newton_gives_up_at_once_where_no_step_reduces_the_residual():
     chord = Chord(ca.Function("no_root", [z, q], [z ** 2 + 1 - q]))
     root = chord.newton(np.array([0.1]), np.array([0.5]), 1e-12, 30)
     assert not root.converged and root.iterations < 10 and np.all(np.isfinite(root.z))
+
+def _coupled_chord():
+    """R(z, q) = A z + 0.1 sin(z) - q for a fixed well-conditioned A (11 x 11:
+    two passes of four columns and a remainder of three in the compiled
+    chord loop's triangular solves)."""
+    import casadi as ca
+
+    from design.solvers.newton import Chord
+    rng = np.random.default_rng(7)
+    a = rng.normal(size=(11, 11)) + 6 * np.eye(11)
+    z, q = ca.SX.sym("z", 11), ca.SX.sym("q", 11)
+    return Chord(ca.Function("coupled", [z, q], [ca.mtimes(ca.DM(a), z) + 0.1 * ca.sin(z) - q]))
+
+
+@pytest.mark.skipif(__import__("design.solvers.compiled", fromlist=["compiler"]).compiler()[0]
+                    is None, reason="no C compiler: the chord loop runs in Python (tested above)")
+def test_the_compiled_chord_loop_finds_the_python_loops_roots():
+    """The chord loop compiled with its residual (design/solvers/native_chord.py)
+    against the same loop in Python with LAPACK's getrs, from the same start
+    with the same factors: both converge or both do not, and their roots
+    agree to the tolerance (their triangular solves round differently).
+    Both outcomes occur: two iterations are too few, and the cubic's factors
+    at z = 5 (a slope 76 times the root's) do not converge within 12."""
+    rng = np.random.default_rng(3)
+    outcomes = set()
+    for chord in (_coupled_chord(), _cubic_chord()):
+        assert chord.native is not None
+        n = chord.native._z.size
+        near, far = (chord.factor(np.full(n, z), np.ones(n)) for z in (0.0, 5.0))
+        for _ in range(20):
+            z0, q = 0.01 * rng.normal(size=n), rng.normal(size=n)
+            for factor, max_iter in ((near, 40), (near, 2), (far, 12)):
+                native = chord.solve(z0, q, factor, 1e-13, max_iter)
+                kept, chord.native = chord.native, None
+                python = chord.solve(z0, q, factor, 1e-13, max_iter)
+                chord.native = kept
+                assert (native is None) == (python is None)
+                outcomes.add(native is None)
+                if native is not None:
+                    np.testing.assert_allclose(native, python, atol=1e-12)
+                    assert np.abs(chord._residual(native, q)[0]).max() <= 1e-13
+    assert outcomes == {True, False}
+    assert chord.solve(np.zeros(2), np.array([2.0, 3.0]), far, 1e-13, 12) is None
+
+
+@pytest.mark.skipif(__import__("design.solvers.compiled", fromlist=["compiler"]).compiler()[0]
+                    is None, reason="no C compiler: the chord loop runs in Python")
+def test_the_compiled_chord_loop_solves_a_linear_system_in_one_update():
+    """R(z, q) = A z - q with A's own factors: one chord update is the
+    solution, so the compiled loop converges with max_iter = 1 exactly when
+    its row swaps and triangular solves are right. A (13 x 13, random normal)
+    needs row swaps; 13 columns take three passes of four and one of one."""
+    import casadi as ca
+
+    from design.solvers.newton import Chord
+    rng = np.random.default_rng(11)
+    a = rng.normal(size=(13, 13))
+    z, q = ca.SX.sym("z", 13), ca.SX.sym("q", 13)
+    chord = Chord(ca.Function("linear13", [z, q], [ca.mtimes(ca.DM(a), z) - q]))
+    factor = chord.factor(np.zeros(13), np.zeros(13))
+    assert np.any(factor.piv != np.arange(13))             # swaps are exercised
+    assert chord.updates == 0
+    for k in range(10):
+        b = rng.normal(size=13)
+        root = chord.solve(np.zeros(13), b, factor, 1e-12 * np.linalg.cond(a), 1)
+        assert root is not None and chord.updates == k + 1
+        np.testing.assert_allclose(root, np.linalg.solve(a, b), atol=1e-12 * np.linalg.cond(a))
+
+
+def test_without_a_compiler_the_chord_method_is_the_python_loop(monkeypatch, tmp_path):
+    """DESIGN_COMPILE=0: no compiled loop, and the chord method still finds
+    the cubic's root from the root's factors."""
+    monkeypatch.setenv("DESIGN_COMPILE", "0")
+    monkeypatch.setenv("DESIGN_CACHE_DIR", str(tmp_path))
+    chord = _cubic_chord()
+    assert chord.native is None
+    q = np.array([2.01, 3.0])
+    z = chord.solve(np.array([1.0, 3.0]), q, chord.factor(np.array([1.0, 3.0]), q), 1e-14, 12)
+    assert z is not None and abs(z[0] ** 3 + z[0] - 2.01) <= 1e-14

@@ -46,6 +46,8 @@ class Compiled:
     functions: list
     compiled: bool
     reason: str
+    #: the shared library's path (None: not compiled)
+    library: str | None = None
 
 
 class CompileLog:
@@ -91,34 +93,37 @@ def compiler() -> tuple[list[str] | None, str]:
     return cc + flags, ""
 
 
-def library_key(functions: list[ca.Function], command: list[str]) -> str:
-    """Hash of the functions' serialized forms, CasADi's version and the
-    compiler command."""
+def library_key(functions: list[ca.Function], command: list[str], extra: str = "") -> str:
+    """Hash of the functions' serialized forms, CasADi's version, the
+    compiler command and the C source added to the functions'."""
     h = hashlib.sha256()
     h.update(ca.__version__.encode())
     h.update(" ".join(command).encode())
     for f in functions:
         h.update(f.name().encode())
         h.update(f.serialize().encode())
+    h.update(extra.encode())
     return h.hexdigest()[:24]
 
 
-def compiled(functions: list[ca.Function]) -> Compiled:
+def compiled(functions: list[ca.Function], extra: str = "") -> Compiled:
     """``functions`` compiled (loaded from the cache, or built into it), or
-    the same functions, interpreted, if that is not possible."""
+    the same functions, interpreted, if that is not possible. ``extra``: C
+    source compiled after the generated code, into the same library (it may
+    call the functions by name; see design/solvers/native_chord.py)."""
     command, reason = compiler()
     if command is None:
         return Compiled(list(functions), False, reason)
     errors = (OSError, RuntimeError, subprocess.SubprocessError)
     try:
-        path, built, seconds = _library(functions, command)
+        path, built, seconds = _library(functions, command, extra)
         try:
             out = [ca.external(f.name(), str(path)) for f in functions]
         except errors:
             if built:
                 raise
             path.unlink(missing_ok=True)        # a cached library that does not load: again
-            path, built, seconds = _library(functions, command)
+            path, built, seconds = _library(functions, command, extra)
             out = [ca.external(f.name(), str(path)) for f in functions]
     except errors as exc:
         return Compiled(list(functions), False,
@@ -126,14 +131,14 @@ def compiled(functions: list[ca.Function]) -> Compiled:
     status.libraries.append({"path": str(path), "built": built, "compile_s": seconds[0],
                              "compile_cpu_s": seconds[1],
                              "functions": [f.name() for f in functions]})
-    return Compiled(out, True, " ".join(command))
+    return Compiled(out, True, " ".join(command), str(path))
 
 
-def _library(functions: list[ca.Function], command: list[str]
+def _library(functions: list[ca.Function], command: list[str], extra: str = ""
              ) -> tuple[Path, bool, tuple[float, float]]:
     """The cached library's path, whether it was built now, and the wall
     time and the compiler's CPU time (s) building it took."""
-    key = library_key(functions, command)
+    key = library_key(functions, command, extra)
     folder = cache_dir()
     path = folder / f"casadi_{key}.so"
     if path.exists():
@@ -146,6 +151,9 @@ def _library(functions: list[ca.Function], command: list[str]
         for f in functions:
             gen.add(f)
         source = Path(gen.generate(tmp + os.sep))
+        if extra:
+            with open(source, "a") as out:
+                out.write(extra)
         target = Path(tmp) / f"{name}.so"
         done = subprocess.run([*command, str(source), "-o", str(target), "-lm"],
                               capture_output=True, text=True)

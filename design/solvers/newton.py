@@ -157,10 +157,13 @@ def compiled_jacobian(residual: ca.Function, name: str) -> ca.Function:
 
 
 class LU(NamedTuple):
-    """LU factors of a Jacobian with their row pivots (LAPACK's getrf)."""
+    """LU factors of a Jacobian with their row pivots (LAPACK's getrf:
+    column-major, 0-based int32 swaps), and the two arrays' addresses (for
+    design/solvers/native_chord.py: taking them costs more than its call)."""
 
     lu: np.ndarray
     piv: np.ndarray
+    addresses: tuple[int, int]
 
 
 class Root(NamedTuple):
@@ -179,6 +182,12 @@ class Root(NamedTuple):
 #: gives up: a residual that no cut of the step reduces has no root nearby
 #: (a step across a fold), and the caller takes a shorter step
 LINE_SEARCH_CUTS = 4
+#: Newton keeps an iteration's Jacobian factors for the next while its full
+#: step cut max |R| below this fraction of what it was (the simplified Newton
+#: method: a Jacobian and its factorisation cost as much as 30-100 compiled
+#: residuals); after a weaker step, or one the line search cut, or where the
+#: kept factors' step does not reduce max |R|, it factors the Jacobian anew
+KEEP_FACTORS_BELOW = 0.1
 
 
 class Chord:
@@ -196,7 +205,16 @@ class Chord:
     def __init__(self, residual: ca.Function):
         from design.solvers.buffers import Buffered
         from design.solvers.compiled import compiled
-        self._residual = Buffered(compiled([residual]).functions[0])
+        from design.solvers.native_chord import NativeChord, source
+        n = residual.size1_in(0)
+        done = compiled([residual], source(residual.name(), n))
+        self._residual = Buffered(done.functions[0])
+        #: the chord loop in C (None: interpreted, the loop in :meth:`solve`)
+        self.native = NativeChord(done.library, residual.name(), n, residual.size1_in(1)) \
+            if done.compiled else None
+        #: chord updates made so far (the cost of :meth:`solve`, one residual
+        #: evaluation and one LU solve each)
+        self.updates = 0
         z = ca.SX.sym("z", residual.size1_in(0))
         q = ca.SX.sym("q", residual.size1_in(1))
         self._jacobian = Buffered(ca.Function(f"{residual.name()}_dense_jz", [z, q],
@@ -210,7 +228,7 @@ class Chord:
         if not np.all(np.isfinite(jac)):
             return None
         lu, piv, info = self._getrf(jac, overwrite_a=True)
-        return LU(lu, piv) if info == 0 else None
+        return LU(lu, piv, (lu.ctypes.data, piv.ctypes.data)) if info == 0 else None
 
     def lu_solve(self, factor: LU, r: np.ndarray) -> np.ndarray:
         """J⁻¹ r from the LU factors of J."""
@@ -220,19 +238,24 @@ class Chord:
               max_iter: int) -> np.ndarray | None:
         """The root from z0 by the chord method with ``factor``, with max |R|
         ≤ ``tolerance``, or None."""
+        if self.native is not None:
+            z, updates = self.native.solve(z0, q, factor, tolerance, max_iter)
+            self.updates += updates
+            return z
         z = np.array(z0, float)
         z_in, q_in = self._residual.inputs
         q_in[:] = q
         with np.errstate(over="ignore", invalid="ignore"):   # a diverging chord: None below
-            for _ in range(max_iter + 1):
+            for it in range(max_iter + 1):
                 z_in[:] = z
                 r = self._residual.run()[0]
                 size = np.abs(r).max()
                 if size <= tolerance:
                     return z
-                if not np.isfinite(size):
+                if not np.isfinite(size) or it == max_iter:
                     return None
                 z -= self._getrs(factor.lu, factor.piv, r)[0]
+                self.updates += 1
         return None
 
     def solve_first(self, z0: np.ndarray, q: np.ndarray, factors: tuple[LU | None, ...],
@@ -252,20 +275,23 @@ class Chord:
 
     def newton(self, z0: np.ndarray, q: np.ndarray, tolerance: float, max_iter: int) -> Root:
         """Newton's method from z0 to max |R| ≤ ``tolerance`` within
-        ``max_iter`` iterations. A step that no halving (at most
-        :data:`LINE_SEARCH_CUTS`) makes reduce max |R| ends the solve."""
+        ``max_iter`` iterations, keeping the factors while they converge fast
+        (:data:`KEEP_FACTORS_BELOW`). A step from a fresh Jacobian that no
+        halving (at most :data:`LINE_SEARCH_CUTS`) makes reduce max |R|
+        ends the solve."""
         z = np.array(z0, float)
         r = self._residual(z, q)[0].ravel()
-        size, factor = float(np.max(np.abs(r))), None
+        size, factor, kept = float(np.max(np.abs(r))), None, False
         with np.errstate(over="ignore", invalid="ignore"):
             for it in range(max_iter):
                 if size <= tolerance:
                     return Root(z, factor, it, True)
                 if not np.isfinite(size):
                     return Root(z, factor, it, False)
-                factor = self.factor(z, q)
-                if factor is None:
-                    return Root(z, None, it, False)
+                if not kept:
+                    factor = self.factor(z, q)
+                    if factor is None:
+                        return Root(z, None, it, False)
                 dz, lam = self.lu_solve(factor, r), 1.0
                 for _ in range(LINE_SEARCH_CUTS + 1):
                     z_try = z - lam * dz
@@ -275,6 +301,10 @@ class Chord:
                         break
                     lam *= 0.5
                 else:
+                    if kept:                      # the kept factors failed: a fresh Jacobian
+                        kept = False
+                        continue
                     return Root(z, factor, it + 1, False)
+                kept = lam == 1.0 and size_try < KEEP_FACTORS_BELOW * size
                 z, r, size = z_try, r_try, size_try
         return Root(z, factor, max_iter, size <= tolerance)
