@@ -122,8 +122,8 @@ class SpatialState:
     quadric: Quadric
     friction: np.ndarray
     post: np.ndarray
-    #: the LU factors of the residual's Jacobian at z (for the chord method;
-    #: None: not computed, as for a trial evaluation's state)
+    #: LU factors of the residual's Jacobian at or near z for the chord method:
+    #: those its chord solve converged with, or its own (None: not computed)
     lu: LU | None = None
 
 
@@ -305,9 +305,12 @@ class SpatialContact:
         """What an accepted instant keeps of a solve without detail: the
         solution with the finger's shape (a finger that passes into the
         object away from the contact is not converged), and the state with
-        its Jacobian's LU factors, to continue from by the chord method. A solve
-        that ended without a state (no contact: a graze, a finger that left
-        the bird) has nothing to add."""
+        LU factors to continue from by the chord method, which become its
+        mode's latest: those its chord solve converged with, else its own
+        Jacobian's, factored now (factoring at every accepted instant cost
+        more than the chord iterations it saves). A solve that ended without
+        a state (no contact: a graze, a finger that left the bird) has
+        nothing to add."""
         if state is None:
             return sol, None
         tr = self.tr[state.mode]
@@ -324,7 +327,7 @@ class SpatialContact:
             sol = replace(sol, converged=False, penetration=float(depth), message="; ".join(
                 m for m in (sol.message, f"the finger passes {depth:.3g} m into the object "
                                          f"away from the contact") if m))
-        lu = tr.chord.factor(state.z, q)
+        lu = state.lu if state.lu is not None else tr.chord.factor(state.z, q)
         if lu is not None:
             self._factors[state.mode] = lu
         return replace(sol, shape_points=r), replace(state, lu=lu)
@@ -341,14 +344,14 @@ class SpatialContact:
             return None
         tr = self.tr[previous.mode]
         q = self._params(quadric, friction)
-        z, _ = tr.chord.solve_first(previous.z, q, (self._factors.get(previous.mode), previous.lu),
-                                    self.tolerance, CHORD_ITERATIONS)
+        z, lu = tr.chord.solve_first(previous.z, q, (self._factors.get(previous.mode), previous.lu),
+                                     self.tolerance, CHORD_ITERATIONS)
         if z is None:
             return None
         post = self.post[previous.mode](z, q)[0].ravel()
         if self._check(previous.mode, post) != "ok":
             return None
-        return SpatialState(previous.mode, z, quadric, friction, post)
+        return SpatialState(previous.mode, z, quadric, friction, post, lu)
 
     def _settle(self, quadric: Quadric, friction: np.ndarray, previous: SpatialState | None):
         """The geometry first, continued from ``previous`` under the friction
