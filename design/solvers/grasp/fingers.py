@@ -63,6 +63,7 @@ from design.solvers.contact.spatial import (FrictionLaw, Quadric, SpatialContact
 from design.solvers.contact.belt_continuation import BELT_MODES, BIRD_MODES, Belted, Plane
 from design.solvers.contact.planar_belt import PlanarBeltContact
 from design.solvers.contact.spatial_belt import SpatialBeltContact
+from design.solvers.grasp.views import finger_views
 
 #: finite-difference step (s) for the rates the friction direction needs
 RATE_STEP = 1e-6
@@ -458,8 +459,9 @@ class SpatialFinger:
     def _resting(self, belt) -> bool:
         """Whether the straight finger's tip is below the belt (``belt``: plane
         and law in the finger frame, or None)."""
-        return belt is not None and belt[0].level(
-            np.array([[self.solver.finger.length], [0.0], [0.0]]))[0] < 0.0
+        # the plane's level at (L, 0, 0): n_x L - e
+        return belt is not None and \
+            belt[0].normal[0] * self.solver.finger.length - belt[0].offset < 0.0
 
     @staticmethod
     def touching(state) -> bool:
@@ -594,25 +596,9 @@ class FrameViews:
 
     def __init__(self, body: Ellipsoid, later: Ellipsoid, dt: float, frames, frames_later,
                  lengths: np.ndarray):
-        bases, R = frames
-        bases2, R2 = frames_later
-        rot, rot2 = body.rotation, later.rotation
-        centre, centre2 = np.asarray(body.center, float), np.asarray(later.center, float)
-        Rt, R2t = R.transpose(0, 2, 1), R2.transpose(0, 2, 1)
-        self.centres = np.einsum("nij,nj->ni", Rt, centre - bases)
-        Rb = Rt @ rot
-        self.matrices = (Rb * np.diag(body.matrix)) @ Rb.transpose(0, 2, 1)
-        # the straight finger's deepest point x* = c·Q e_x / Q00, clipped to it
-        Q0 = self.matrices[:, 0]
-        x = np.clip(np.einsum("nj,nj->n", Q0, self.centres) / Q0[:, 0], 0.0, lengths)
-        d = -self.centres
-        d[:, 0] += x
-        self.levels = np.einsum("ni,nij,nj->n", d, self.matrices, d) - 1.0
-        turn = R2t @ (rot2 @ rot.T)
-        self.v0 = (np.einsum("nij,nj->ni", R2t, centre2 - bases2) +
-                   np.einsum("nij,nj->ni", turn, bases - centre)) / dt
-        self.gradients = (turn @ R - np.eye(3)) / dt
-        self._later = (later, R2t, bases2, dt)
+        self.centres, self.matrices, self.levels, self.v0, self.gradients = finger_views(
+            body, later, dt, frames, frames_later, lengths)
+        self._later = (later, frames_later[1].transpose(0, 2, 1), frames_later[0], dt)
         self._views: dict[int, FrameView] = {}
 
     def __getitem__(self, k: int) -> FrameView:
@@ -832,14 +818,16 @@ class FingerForces:
         self._memo[key] = out, skipped
         return out
 
-    def _waiting(self) -> set[int]:
-        """The fingers whose contact starts only at an accepted instant
-        (``touches_at_commits``) that did not touch the bird at the last one
-        (none before the first: a bird may start in the fingers)."""
+    def _waiting(self, among=None) -> set[int]:
+        """The fingers (``among`` these indices, else all) whose contact starts
+        only at an accepted instant (``touches_at_commits``) that did not
+        touch the bird at the last one (none before the first: a bird may
+        start in the fingers)."""
         if not self._committed:
             return set()
-        return {i for i, m in enumerate(self.models)
-                if m.touches_at_commits and not m.touching(self.states[i])}
+        return {i for i in (range(len(self.models)) if among is None else among)
+                if self.models[i].touches_at_commits
+                and not self.models[i].touching(self.states[i])}
 
     def touch_margin(self, t: float, y: np.ndarray) -> float:
         """The least clearance (m) from the bird at (t, y) of the fingers
@@ -860,13 +848,18 @@ class FingerForces:
         trial left out, waiting for their contact to start at an accepted
         instant."""
         body = self.ellipsoid(y)
-        loads, states = Loads(), []
+        loads = Loads()
         reaching = self.reaching(t, y, body)
-        waiting = set() if commit else self._waiting()
-        skipped = sorted(reaching & waiting)
-        for i in range(len(self.models)):
-            solved = self._solve(i, t, y, body, commit) if i in reaching - waiting else None
-            states.append(self._state(i, t, y, body, solved, commit, loads))
+        skipped = [] if commit else sorted(self._waiting(reaching))
+        states = [OUT_OF_REACH] * len(self.models)
+        for i in range(len(self.models)):           # out of reach or left out: no contact
+            if i not in reaching or i in skipped:
+                self.trials[i] = None
+                if commit:
+                    self.states[i] = None
+        for i in sorted(reaching.difference(skipped)):
+            states[i] = self._state(i, t, y, body, self._solve(i, t, y, body, commit), commit,
+                                    loads)
         return (loads, states), skipped
 
     def _solve(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, commit: bool):
