@@ -162,6 +162,30 @@ def test_a_step_in_pose_and_friction_at_once_lands_where_the_continuation_does()
                                atol=1e-8 * np.linalg.norm(direct.force))
 
 
+def test_a_contact_crossing_between_interior_and_tip_is_followed_by_the_chord_method():
+    """An object moved 2 mm along the finger across where its contact
+    leaves the tip (x0 = 0.2385 -> 0.2405 m), and back: the chord method from
+    the solved contact finds the contact in the other mode with that mode's
+    latest factors, without a Newton iteration, where Newton from the same
+    start (:meth:`SpatialContact._step`) finds the same force (1e-10 of its
+    0.34 N: both stop at the residual tolerance)."""
+    from design.solvers.contact.spatial import NO_FRICTION
+    solver = SpatialContact(thesis_finger())
+    at = {x: ellipsoid_on(Ellipse(0.0991, 0.0673, (x, -0.03), 0.0)) for x in (0.2385, 0.2405)}
+    for start, end, modes in ((0.2385, 0.2405, ("interior", "tip")),
+                              (0.2405, 0.2385, ("tip", "interior"))):
+        _, previous = solver.solve(at[start], np.zeros(3))
+        solver.solve(at[end], np.zeros(3))               # the other mode's latest factors
+        _, previous = solver.solve(at[start], np.zeros(3), previous)
+        solver.newton_iterations = 0
+        chord = solver._chord(previous, at[end], NO_FRICTION)
+        assert (previous.mode, chord.mode) == modes and solver.newton_iterations == 0
+        newton = solver._step(previous, at[end], NO_FRICTION)
+        assert newton.mode == chord.mode and solver.newton_iterations > 0
+        np.testing.assert_allclose(chord.post[10:13], newton.post[10:13],
+                                   atol=1e-10 * np.linalg.norm(newton.post[10:13]))
+
+
 def test_no_contact_and_invalid_poses_are_told_apart():
     solver = SpatialContact(thesis_finger())
     far = ellipsoid_on(Ellipse(0.0991, 0.0673, (0.12, -0.2)))

@@ -28,6 +28,7 @@ import subprocess
 import tempfile
 import time
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 
 import casadi as ca
@@ -132,6 +133,14 @@ def compiled(functions: list[ca.Function], extra: str = "") -> Compiled:
                              "compile_cpu_s": seconds[1],
                              "functions": [f.name() for f in functions]})
     return Compiled(out, True, " ".join(command), str(path))
+
+
+@lru_cache(maxsize=None)
+def compiled_once(f: ca.Function) -> ca.Function:
+    """``f`` compiled as :func:`compiled` does it, once per process for the
+    same function object (a model built again for every run takes its
+    functions from a cached transcription)."""
+    return compiled([f]).functions[0]
 
 
 def _library(functions: list[ca.Function], command: list[str], extra: str = ""

@@ -42,6 +42,7 @@ from typing import NamedTuple
 import numpy as np
 
 from design.solvers.buffers import Buffered
+from design.solvers.compiled import compiled_once
 from design.solvers.contact.robust import BASE_FRACTION, BASE_REACHED, MAX_STEP_ITERATIONS
 from design.solvers.contact.spatial import CHORD_ITERATIONS
 from design.solvers.newton import LU
@@ -430,11 +431,11 @@ class BeltedContact:
         return replace(state, lu=lu)
 
     def calls(self, mode: str) -> tuple[Buffered, Buffered]:
-        """A mode's post values and the finger's shape, called through
-        buffers (design/solvers/buffers.py)."""
+        """A mode's post values and the finger's shape, compiled, called
+        through buffers (design/solvers/buffers.py)."""
         if mode not in self._calls:
             tr = self.transcription(mode)
-            self._calls[mode] = (Buffered(tr.post), Buffered(tr.shape))
+            self._calls[mode] = tuple(Buffered(compiled_once(f)) for f in (tr.post, tr.shape))
         return self._calls[mode]
 
     # --------------------------------------------------------- the model's

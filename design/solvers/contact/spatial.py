@@ -37,6 +37,7 @@ from design.solvers.contact.robust import (BASE_FRACTION, BASE_REACHED, MAX_STEP
                                          PENETRATION_TOL, follow)
 from design.solvers.contact.spatial_equations import MODES, spatial_transcription
 from design.solvers.buffers import Buffered, evaluate
+from design.solvers.compiled import compiled_once
 from design.solvers.newton import LU, implicit_rate
 
 #: the straight finger is not inside the object at its deepest point (it
@@ -60,6 +61,12 @@ class Quadric:
         """< 0 inside; pts (3, n)."""
         d = pts - self.center[:, None]
         return np.einsum("in,ij,jn->n", d, self.matrix, d) - 1.0
+
+    @property
+    def base_level(self) -> float:
+        """The level at the frame's origin, the finger's base (< 0: inside)."""
+        c = self.center
+        return float(c @ self.matrix @ c) - 1.0
 
     def normal(self, p: np.ndarray) -> np.ndarray:
         g = self.matrix @ (p - self.center)
@@ -261,10 +268,10 @@ class SpatialContact:
         #: the parameters that follow the quadric and friction law (mesh, stiffness)
         self.tail = np.concatenate([self.widths, self.stiffness.params])
         self.tr = {m: spatial_transcription(self.stiffness, intervals, degree, m) for m in MODES}
-        #: each mode's post values (and residual size) and shape, called through
-        #: buffers of this solver's own (design/solvers/buffers.py)
-        self.post = {m: Buffered(self.tr[m].post) for m in MODES}
-        self.shape = {m: Buffered(self.tr[m].shape) for m in MODES}
+        #: each mode's post values (and residual size) and shape, compiled, called
+        #: through buffers of this solver's own (design/solvers/buffers.py)
+        self.post = {m: Buffered(compiled_once(self.tr[m].post)) for m in MODES}
+        self.shape = {m: Buffered(compiled_once(self.tr[m].shape)) for m in MODES}
         self.newton_iterations = 0
         #: mode -> the Jacobian factors of the latest root found in it
         self._factors: dict[str, LU] = {}
@@ -280,7 +287,7 @@ class SpatialContact:
         self.newton_iterations = 0
         length = self.finger.length
         friction = FrictionLaw.of(friction).params
-        if quadric.level(np.zeros((3, 1)))[0] <= 0.0:
+        if quadric.base_level <= 0.0:
             return no_spatial_contact(length, "the finger base is inside the object: invalid "
                                               "pose", converged=False), None
         if (segment_level(quadric, length) if level is None else level) >= 0.0:
@@ -335,23 +342,33 @@ class SpatialContact:
     def _chord(self, previous: SpatialState, quadric: Quadric, friction: np.ndarray
                ) -> SpatialState | None:
         """The contact at the new parameters by the chord method from
-        ``previous`` (its mode kept), if it has its Jacobian factors and
-        converges within CHORD_ITERATIONS with the mode still right; else
-        None. It tries the mode's latest factors first (the latest Newton's
-        or commit's: nearest the states an integrator's trials solve again
-        and again about one instant), then ``previous``'s own."""
+        ``previous``, if it has its Jacobian factors and converges within
+        CHORD_ITERATIONS with the mode right; else None. It tries the mode's
+        latest factors first (the latest Newton's or commit's: nearest the
+        states an integrator's trials solve again and again about one
+        instant), then ``previous``'s own. Where the root says the contact
+        switched between interior and tip, the chord goes on in the other
+        mode with that mode's latest factors, as :meth:`_step` goes on with
+        Newton (trials about a switch each paid two Newton solves)."""
         if previous.lu is None:
             return None
-        tr = self.tr[previous.mode]
         q = self._params(quadric, friction)
-        z, lu = tr.chord.solve_first(previous.z, q, (self._factors.get(previous.mode), previous.lu),
-                                     self.tolerance, CHORD_ITERATIONS)
-        if z is None:
-            return None
-        post = self.post[previous.mode](z, q)[0].ravel()
-        if self._check(previous.mode, post) != "ok":
-            return None
-        return SpatialState(previous.mode, z, quadric, friction, post, lu)
+        mode, z, factors = previous.mode, previous.z, (self._factors.get(previous.mode),
+                                                       previous.lu)
+        for _ in range(2):
+            z, lu = self.tr[mode].chord.solve_first(z, q, factors, self.tolerance,
+                                                    CHORD_ITERATIONS)
+            if z is None:
+                return None
+            post = self.post[mode](z, q)[0].ravel()
+            verdict = self._check(mode, post)
+            if verdict == "ok":
+                return SpatialState(mode, z, quadric, friction, post, lu)
+            if verdict not in ("tip", "interior"):
+                return None
+            mode, z = self._switched(verdict, z)
+            factors = (self._factors.get(mode),)
+        return None
 
     def _settle(self, quadric: Quadric, friction: np.ndarray, previous: SpatialState | None):
         """The geometry first, continued from ``previous`` under the friction
@@ -457,7 +474,6 @@ class SpatialContact:
     def _step(self, state: SpatialState, quadric: Quadric, friction: np.ndarray):
         """Newton at new parameters from ``state``, with mode switches; None on failure."""
         mode, z = state.mode, state.z
-        nw = self.tr["interior"].rod.n_w
         for _ in range(3):
             z_new, ok, post = self._newton(mode, z, quadric, friction)
             if not ok:
@@ -467,11 +483,14 @@ class SpatialContact:
                 return SpatialState(mode, z_new, quadric, friction, post)
             if verdict in ("release", "base"):
                 return verdict
-            if verdict == "tip":
-                mode, z = "tip", z_new[:nw + 1]
-            else:
-                mode, z = "interior", np.concatenate([z_new, [1.0]])
+            mode, z = self._switched(verdict, z_new)
         return None
+
+    def _switched(self, mode: str, z: np.ndarray) -> tuple[str, np.ndarray]:
+        """A root's unknowns z carried into ``mode`` (tip: the contact's place
+        along the finger dropped; interior: it added, at the tip)."""
+        nw = self.tr["interior"].rod.n_w
+        return (mode, z[:nw + 1]) if mode == "tip" else (mode, np.concatenate([z, [1.0]]))
 
     def _newton(self, mode, z0, quadric, friction):
         tr = self.tr[mode]

@@ -70,7 +70,7 @@ class SpatialBeltContact(BeltedContact):
         state, lost at a coarser stall). Returns the solution, whose extras'
         ``continuation_lost`` says whether it was found afresh, and the
         state to continue from."""
-        if quadric is not None and quadric.level(np.zeros((3, 1)))[0] <= 0.0:
+        if quadric is not None and quadric.base_level <= 0.0:
             return self._failed("the finger base is inside the object: invalid pose"), None
         target = Belted("free", None, None if quadric is None else quadric.params,
                         FrictionLaw.of(friction).params, plane, FrictionLaw.of(belt).params)
