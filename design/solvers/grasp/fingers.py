@@ -158,29 +158,30 @@ def reach_windows(grasper: Grasper, bird: Bird, speed: float, centre_path, t_end
     the bird, padded by one sample.
 
     Conservative: the bird's centre is anywhere within ``margin`` (m) of
-    ``centre_path(t)`` = (X, Z) along X and between the conveyor and ``margin``
-    above the path in Z, and any orientation; a finger can touch only if its
-    undeformed segment comes within the largest semi-axis of that region.
-    Contact needs the straight finger to enter the bird, so outside these
-    windows the force is zero.
+    ``centre_path(times)`` = (X, Z) (arrays, or Z a scalar) along X and
+    between the conveyor and ``margin`` above the path in Z, and any
+    orientation; a finger can touch only if its undeformed segment comes
+    within the largest semi-axis of that region. Contact needs the straight
+    finger to enter the bird, so outside these windows the force is zero.
     """
     drum = grasper.drum(speed)
     times = np.arange(0.0, t_end + dt, dt)
     reach = max(bird.eta, bird.lam, bird.gamma)
-    centres = np.array([centre_path(t) for t in times])               # (n, 2): X, Z
-    lo = np.stack([centres[:, 0] - margin, np.zeros(times.size), np.zeros(times.size)], axis=1)
-    hi = np.stack([centres[:, 0] + margin, np.zeros(times.size), centres[:, 1] + margin], axis=1)
-    s = np.linspace(0.0, 1.0, 24)[None, :, None]
+    x, z = np.broadcast_arrays(*(np.asarray(c, float) for c in centre_path(times)))
+    x, top = x[:, None], z[:, None] + margin                          # (n, 1)
+    s = np.linspace(0.0, 1.0, 24)[None, :]
     turns = drum.turning(times)
     out = []
     for gf in grasper.fingers:
         base0, R0 = drum.frame(gf.mount, 0.0)
         base = drum.origin + turns @ (base0 - drum.origin)
-        axis = turns @ R0[:, 0]
-        pts = base[:, None, :] + s * gf.finger.length * axis[:, None, :]   # (n, 24, 3)
-        gap = np.maximum(np.maximum(lo[:, None, :] - pts, 0.0), pts - hi[:, None, :])
-        near = np.min(np.linalg.norm(gap, axis=2), axis=1) <= reach
-        out.append(_windows(near, times, dt))
+        axis = turns @ R0[:, 0] * gf.finger.length
+        # the segment's points (n, 24) and their distances outside the region
+        # [x - margin, x + margin] x {0} x [0, top], squared
+        px, py, pz = (base[:, k, None] + s * axis[:, k, None] for k in range(3))
+        gap2 = np.maximum(np.abs(px - x) - margin, 0.0) ** 2 + py ** 2 + \
+            np.maximum(np.maximum(-pz, pz - top), 0.0) ** 2
+        out.append(_windows(np.min(gap2, axis=1) <= reach ** 2, times, dt))
     return out
 
 
