@@ -32,6 +32,7 @@ CASES = {
     "adaptive dop853": IntegratorSettings(stepper="dop853"),
     # implicit, for scenes whose fingers' regularised friction is stiff
     "adaptive radau": IntegratorSettings(stepper="radau"),
+    "adaptive bdf": IntegratorSettings(stepper="bdf"),
     # the thesis's method as it ran: no bound on a step's estimated local error
     "bdf4 (thesis) 16.6 ms": IntegratorSettings(integrator="bdf4", step=16.6e-3,
                                                 max_local_error=math.inf),

@@ -1,24 +1,25 @@
 """Integrating the grasp: an event-driven adaptive integrator (default) and the
 thesis's fixed-step BDF-4 with frozen forces (baseline).
 
-Adaptive (``adaptive``): explicit Runge-Kutta with error control (scipy's
-DOP853 or RK45 stepper), one smooth ODE per conveyor mode (air, slip,
-stick). Mode switches are events located on the step's dense output by a
-root finder: lift-off (N = 0), touch-down (the lowest point reaches the
-belt, plastic impact), stick/slip of the lowest point on the belt, the
-start and end of the conveyor's deceleration, and a finger's friction
-reversing (its sliding against its friction passing the reversal speed).
-Finger contacts are evaluated at every stage with the friction of the last
-accepted instant; each accepted instant settles it, and the stepper restarts
-when one turns. A spatial finger's first touch of the bird is an event too:
-trials leave out a finger that did not touch the bird at the last accepted
-instant, and a step at whose end one touches it ends where its clearance
-crosses zero (design/solvers/grasp/fingers.py). Located as an event, a
-reversal comes where the sliding says, not up to a step late, so the hold
-and peak force do not depend on where the steps fell (``python -m
-benchmarks.grasp``). A finger's force maxima between accepted instants are
-located on the dense output (design/solvers/grasp/peaks.py), so that the
-peak force does not depend on the step either.
+Adaptive (``adaptive``): scipy's steppers with error control (explicit
+Runge-Kutta, DOP853 or RK45; or implicit, Radau or BDF, for stiff scenes),
+one smooth ODE per conveyor mode (air, slip, stick). Mode switches are
+events located on the step's dense output by a root finder: lift-off
+(N = 0), touch-down (the lowest point reaches the belt, plastic impact),
+stick/slip of the lowest point on the belt, the start and end of the
+conveyor's deceleration, and a finger's friction reversing (its sliding
+against its friction passing the reversal speed). Finger contacts are
+evaluated at every stage with the friction of the last accepted instant;
+each accepted instant settles it, and the stepper restarts when one turns. A
+spatial finger's first touch of the bird is an event too: trials leave out a
+finger that did not touch the bird at the last accepted instant, and a step
+at whose end one touches it ends where its clearance crosses zero
+(design/solvers/grasp/fingers.py). Located as an event, a reversal comes
+where the sliding says, not up to a step late, so the hold and peak force do
+not depend on where the steps fell (``python -m benchmarks.grasp``). A
+finger's force maxima between accepted instants are located on the dense
+output (design/solvers/grasp/peaks.py), so that the peak force does not
+depend on the step either.
 
 BDF-4 (``bdf4``, thesis §4.4): fixed step h, forces frozen over the step,
 conveyor friction sign updated at the end of the step, the conveyor contact
@@ -37,7 +38,7 @@ from dataclasses import dataclass, field
 from math import comb
 
 import numpy as np
-from scipy.integrate import DOP853, RK45, Radau
+from scipy.integrate import BDF, DOP853, RK45, Radau
 from scipy.optimize import brentq
 
 from design.physics.bird import G, BirdDynamics, Conveyor, Loads
@@ -46,9 +47,12 @@ from design.solvers.grasp.fingers import (ContactFailed, FingerForces, FingerSta
 from design.solvers.grasp.peaks import PeakFinder, Span
 from design.solvers.newton import damped_newton, forward_difference
 
-STEPPERS = {"dop853": DOP853, "rk45": RK45, "radau": Radau}
+#: scipy's steppers: explicit Runge-Kutta (rk45, dop853) and implicit, for
+#: stiff scenes: Radau IIA of order 5 (radau) and variable-order BDF, orders
+#: 1 to 5 (bdf; not the thesis's fixed-step ``bdf4`` integrator)
+STEPPERS = {"dop853": DOP853, "rk45": RK45, "radau": Radau, "bdf": BDF}
 #: the steppers that take the right-hand side's Jacobian (Grasp.jacobian)
-IMPLICIT = ("radau",)
+IMPLICIT = ("radau", "bdf")
 #: relative step of Grasp.jacobian's differences: sqrt of the double's epsilon
 JACOBIAN_STEP = np.finfo(float).eps ** 0.5
 INTEGRATORS = ("adaptive", "bdf4")
