@@ -330,6 +330,23 @@ def test_the_deepest_point_of_a_straight_finger_is_found_between_its_nodes():
 
 
 
+def test_the_deepest_point_just_before_a_node_does_not_depend_on_round_off():
+    """A straight centreline with eleven nodes 10 mm apart and a circle dipping
+    below it at 49.9 mm, 0.1 mm before the sixth node: the grid's least
+    value is at that node, where the two gaps that meet give values equal
+    up to round-off. Whichever round-off makes the lower, the deepest point
+    is the circle's (0.499 of the length, level ((r - d) / r)² - 1), for
+    centres moved by a few units in the last place."""
+    r, d = 0.05, 2e-3
+    points = np.array([np.linspace(0.0, 0.1, 11), np.zeros(11)])
+    tangents = np.array([np.ones(11), np.zeros(11)])
+    for k in range(-8, 9):
+        center = np.array([0.0499 * (1 + k * 2e-16), r - d])
+        found = deepest(points, tangents, center, np.eye(2) / r ** 2)
+        assert found.level == pytest.approx(((r - d) / r) ** 2 - 1, rel=1e-12)
+        assert found.fraction == pytest.approx(0.499, abs=1e-12)
+
+
 def test_the_deepest_point_of_a_bent_finger_is_the_hermite_curve_s():
     """Four points on a circular arc (radius 0.2 m) with their tangents and
     an ellipse (50 x 30 mm, turned 0.3 rad) dipping about 1 mm below the arc

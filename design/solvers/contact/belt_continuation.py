@@ -96,6 +96,9 @@ class Deepest(NamedTuple):
 
 #: where :func:`deepest` first looks along each gap between a finger's points
 GAP_GRID = np.linspace(0.0, 1.0, 33)
+#: the powers 0 to 6 of :data:`GAP_GRID` (7, 33): a degree-6 polynomial's
+#: values there are its coefficients times these
+GAP_POWERS = GAP_GRID[None, :] ** np.arange(7)[:, None]
 
 
 def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
@@ -107,22 +110,40 @@ def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
     parameter, minimised on :data:`GAP_GRID` and polished by Newton's
     method inside the grid cells about the least value (a polynomial's
     roots are inaccurate when its top coefficients are round-off, as on a
-    straight gap). Between the points a convex bird can cross the chord
-    unseen."""
+    straight gap). Where the least value is at a point the finger's curve
+    passes, both gaps that meet there are polished and the lower taken: the
+    two gaps' values there differ by round-off alone. Between the points a
+    convex bird can cross the chord unseen."""
     rel = points - center[:, None]
     chords = np.linalg.norm(np.diff(points, axis=1), axis=0)
     p0, p1 = rel[:, :-1], rel[:, 1:]
     m0, m1 = chords * tangents[:, :-1], chords * tangents[:, 1:]
     # r(s) - c = Σ_i a_i s^i over each gap, s in [0, 1]; the level is Σ_ij a_iᵀ M a_j s^(i+j) - 1
     a = np.stack([p0, m0, 3 * (p1 - p0) - 2 * m0 - m1, 2 * (p0 - p1) + m0 + m1])
-    gram = np.einsum("ikn,kl,jln->nij", a, matrix, a)
+    per_gap = a.transpose(2, 0, 1)                                # (gaps, 4, dim)
+    gram = per_gap @ matrix @ per_gap.transpose(0, 2, 1)          # a_iᵀ M a_j
     coef = np.zeros((chords.size, 7))
     for i in range(4):
         coef[:, i:i + 4] += gram[:, i]
     coef[:, 0] -= 1.0
-    values = np.polynomial.polynomial.polyval(GAP_GRID, coef.T)
+    values = coef @ GAP_POWERS
     k, j = np.unravel_index(int(np.argmin(values)), values.shape)
-    level = coef[k].tolist()
+    last = GAP_GRID.size - 1
+    cells = [(k, j)] + ([(k - 1, last)] if j == 0 and k > 0 else []) + \
+        ([(k + 1, 0)] if j == last and k + 1 < chords.size else [])
+    (level, u), k = min((_polished(coef[g], values[g, c], c), g) for g, c in cells)
+    tangent = np.tensordot(np.arange(4) * np.concatenate([[0.0], u ** np.arange(3)]),
+                           a[:, :, k], axes=1)
+    return Deepest(level, float((chords[:k].sum() + chords[k] * u) / chords.sum()),
+                   center + np.tensordot(u ** np.arange(4), a[:, :, k], axes=1),
+                   tangent / np.linalg.norm(tangent))
+
+
+def _polished(coef: np.ndarray, value: float, j: int) -> tuple[float, float]:
+    """A gap's level polynomial (coefficients, degree 6) minimised by
+    Newton's method from grid point j (its value there ``value``) within the
+    cells beside it: (the least level found, its parameter u)."""
+    level = coef.tolist()
     slope = [i * c for i, c in enumerate(level)][1:]
     curvature = [i * c for i, c in enumerate(slope)][1:]
     lo, hi = GAP_GRID[max(j - 1, 0)], GAP_GRID[min(j + 1, GAP_GRID.size - 1)]
@@ -135,13 +156,8 @@ def deepest(points: np.ndarray, tangents: np.ndarray, center: np.ndarray,
         done, u = step == u, step
         if done:
             break
-    if horner(level, u) > values[k, j]:
-        u = float(GAP_GRID[j])
-    tangent = np.tensordot(np.arange(4) * np.concatenate([[0.0], u ** np.arange(3)]),
-                           a[:, :, k], axes=1)
-    return Deepest(horner(level, u), float((chords[:k].sum() + chords[k] * u) / chords.sum()),
-                   center + np.tensordot(u ** np.arange(4), a[:, :, k], axes=1),
-                   tangent / np.linalg.norm(tangent))
+    found = horner(level, u)
+    return (found, u) if found <= value else (value, float(GAP_GRID[j]))
 
 
 def horner(coef: list[float], u: float) -> float:
