@@ -263,11 +263,11 @@ class Chord:
         """:meth:`solve` with each of ``factors`` in turn (None and repeats
         skipped) until one converges: (the root, the factors it took), else
         (None, None)."""
-        tried: list[LU] = []
+        tried: set[int] = set()
         for factor in factors:
-            if factor is None or any(factor is t for t in tried):
+            if factor is None or id(factor) in tried:
                 continue
-            tried.append(factor)
+            tried.add(id(factor))
             z = self.solve(z0, q, factor, tolerance, max_iter)
             if z is not None:
                 return z, factor
