@@ -186,6 +186,27 @@ def test_a_contact_crossing_between_interior_and_tip_is_followed_by_the_chord_me
                                    atol=1e-10 * np.linalg.norm(newton.post[10:13]))
 
 
+def test_an_accepted_solve_keeps_the_factors_its_chord_solve_converged_with():
+    """A short step solved by the chord method and detailed for an accepted
+    instant keeps the factors it converged with (the previous state's, here)
+    for the next steps, with no Jacobian factored: factoring at every
+    accepted instant cost more than the chord iterations it saves."""
+    solver = SpatialContact(thesis_finger())
+    target = ellipsoid_on(ELLIPSES["deep"], 0.5)
+    _, previous = solver.solve(target, np.zeros(3))
+    assert previous.lu is not None
+    chord = solver.tr[previous.mode].chord
+    factored = []
+    factor = chord.factor
+    chord.factor = lambda z, q: factored.append(z) or factor(z, q)
+    try:
+        _, state = solver.solve(target.shifted(np.array([0.0, -1e-4, 0.0])), np.zeros(3),
+                                previous)
+    finally:
+        del chord.factor
+    assert state.lu is previous.lu and not factored and solver.newton_iterations == 0
+
+
 def test_no_contact_and_invalid_poses_are_told_apart():
     solver = SpatialContact(thesis_finger())
     far = ellipsoid_on(Ellipse(0.0991, 0.0673, (0.12, -0.2)))
