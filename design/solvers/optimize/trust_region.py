@@ -69,7 +69,7 @@ BACK_OFF = 0.9
 #: each loop simulation's budget of the belt continuations' Newton solves
 #: (where the chord method did not converge) per simulated second
 #: (IntegratorSettings.max_newton_solves): Table 5-5's birds at the baseline
-#: make 1.9-3.8 a second, the main job's designs at most 14 in a 1.6 s run; a
+#: make 1.9-3.8 a second, the main job's designs at most 15 in a 1.6 s run; a
 #: finger pressed to where its quasi-static contact ends (a fold it snaps
 #: through at every trial of a step, a touch with no consistent contact)
 #: makes them by the hundred within tenths of a second (measured while a
