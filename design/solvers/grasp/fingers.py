@@ -852,12 +852,8 @@ class FingerForces:
         loads = Loads()
         reaching = self.reaching(t, y, body)
         skipped = [] if commit else sorted(self._waiting(reaching))
-        states = [OUT_OF_REACH] * len(self.models)
-        for i in range(len(self.models)):           # out of reach or left out: no contact
-            if i not in reaching or i in skipped:
-                self.trials[i] = None
-                if commit:
-                    self.states[i] = None
+        states = [self._no_contact(i, commit) if i not in reaching or i in skipped
+                  else OUT_OF_REACH for i in range(len(self.models))]
         for i in sorted(reaching.difference(skipped)):
             states[i] = self._state(i, t, y, body, self._solve(i, t, y, body, commit), commit,
                                     loads)
@@ -893,10 +889,7 @@ class FingerForces:
         its force added to ``loads`` (both drums)."""
         force, p_w, sol, cont = solved or (None,) * 4
         if force is None:                           # out of reach: no contact problem
-            self.trials[i] = None
-            if commit:
-                self.states[i] = None
-            return OUT_OF_REACH
+            return self._no_contact(i, commit)
         self.solves += 1
         state = self._kept(i, t, y, body, force, p_w, sol, cont, commit)
         if p_w is not None:
@@ -905,6 +898,13 @@ class FingerForces:
             loads.qz += 2 * force[2]
             loads.ty += 2 * (r[2] * force[0] - r[0] * force[2])
         return state
+
+    def _no_contact(self, i: int, commit: bool) -> FingerState:
+        """Finger i out of reach (or left out): no contact to continue from."""
+        self.trials[i] = None
+        if commit:
+            self.states[i] = None
+        return OUT_OF_REACH
 
     def _kept(self, i: int, t: float, y: np.ndarray, body: Ellipsoid, force: np.ndarray,
               p_w: np.ndarray | None, sol, cont, commit: bool) -> FingerState:
