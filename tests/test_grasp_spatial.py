@@ -168,7 +168,8 @@ def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():
     and seen from the drum-turned frame (1e-8 m/s: rounding of positions of
     0.1 m divided by the 1e-6 s step). The mean bird moving and pitching
     at finger 4a. Its quadric and the straight finger's level, computed
-    with every finger's at once, are the single finger's (to rounding)."""
+    with every finger's at once, are the single finger's (to rounding), and
+    its parameters' rates the forward difference of that quadric."""
     setup = mean_bird_setup("soft")
     forces = fingers_of(setup)
     b = setup.bird
@@ -194,3 +195,8 @@ def test_the_surface_motion_is_the_birds_seen_from_the_turning_finger():
         expected = (R2.T @ (carried - base2) - p) / dt
         np.testing.assert_allclose(motion(p)[1], expected, rtol=0, atol=1e-8)
     assert np.linalg.norm(motion.gradient) > 0.5          # the pitch rate and drum turn show
+    # the quadric's parameter rates: the same forward difference of the
+    # quadric seen from the finger's frame dt on
+    rates = (body_quadric(later, base2, R2).params - quadric.params) / dt
+    np.testing.assert_allclose(motion.rates, rates, rtol=1e-9, atol=1e-6)
+    assert np.abs(rates).max() > 0.1

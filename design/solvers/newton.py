@@ -215,8 +215,7 @@ class Chord:
         #: chord updates made so far (the cost of :meth:`solve`, one residual
         #: evaluation and one LU solve each)
         self.updates = 0
-        z = ca.SX.sym("z", residual.size1_in(0))
-        q = ca.SX.sym("q", residual.size1_in(1))
+        z, q = ca.SX.sym("z", n), ca.SX.sym("q", residual.size1_in(1))
         self._jacobian = Buffered(ca.Function(f"{residual.name()}_dense_jz", [z, q],
                                               [ca.densify(ca.jacobian(residual(z, q), z))]))
         self._getrf, self._getrs = get_lapack_funcs(("getrf", "getrs"), (np.zeros(1),))

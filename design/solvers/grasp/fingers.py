@@ -599,7 +599,7 @@ class FrameViews:
                  lengths: np.ndarray):
         self.centres, self.matrices, self.levels, self.v0, self.gradients = finger_views(
             body, later, dt, frames, frames_later, lengths)
-        self._later = (later, frames_later[1].transpose(0, 2, 1), frames_later[0], dt)
+        self._later = (later, frames_later, dt)
         self._views: dict[int, FrameView] = {}
 
     def __getitem__(self, k: int) -> FrameView:
@@ -612,11 +612,8 @@ class FrameViews:
 
     def _rates(self, k: int, quadric: Quadric) -> np.ndarray:
         """The rates of finger k's quadric parameters (forward difference)."""
-        later, R2t, bases2, dt = self._later
-        Rb = R2t[k] @ later.rotation
-        moved = Quadric(R2t[k] @ (np.asarray(later.center, float) - bases2[k]),
-                        Rb @ later.matrix @ Rb.T)
-        return (moved.params - quadric.params) / dt
+        later, (bases2, R2), dt = self._later
+        return (body_quadric(later, bases2[k], R2[k]).params - quadric.params) / dt
 
 
 def _nearer(accepted, trial):
